@@ -1,0 +1,39 @@
+#pragma once
+// Drivers: apply the kernels of kernels.hpp over the neighbour lists, in parallel on oneTBB.
+// Each has a serial twin (the Serial scatter plan, or a single-thread arena) and the results do
+// not depend on the thread count.
+
+#include <cstddef>
+
+#include "gpa/engine/colouring.hpp"
+#include "gpa/engine/compressed_rows.hpp"
+#include "gpa/engine/fields.hpp"
+#include "gpa/engine/weights.hpp"
+
+namespace gpa {
+
+// Gather over the neighbours of every centre in [0, lists.rows()): geometry factors alpha,
+// velocity gradient L, volumetric strain rate (with the hoop rate in axisymmetric geometry)
+// and the smallest h_ij (spec section 3; Eq. 7-15, 42-53). A plain parallel loop: each centre
+// writes only its own values.
+// Throws InputError naming the node when a neighbourhood gives no geometry factor along some
+// axis (an empty or flat neighbourhood) and NumericalError when two nodes coincide.
+template <class G>
+void compute_velocity_gradient(const CompressedRows& lists, WeightKind weight,
+                               const GradientFields<G::dim>& f);
+
+struct BondViscosityParameters {
+    double linear = 0.2;     // C_L
+    double quadratic = 4.0;  // C_Q
+    double eps0 = 0.01;      // regularisation of mu_ij (Eq. 38)
+};
+
+// Pairwise forces (Eq. 21-24, 54-56), with bond viscosity (Eq. 37-38) when `bond` is given and
+// the hoop term for axisymmetric centres (spec section 5). Zeroes f.force for every node the
+// lists touch, then scatters by the colours of `plan`.
+template <class G>
+void compute_forces(const CompressedRows& lists, const ScatterPlan& plan, WeightKind weight,
+                    const BondViscosityParameters* bond, const ForceFields<G::dim>& f,
+                    std::size_t node_count);
+
+}  // namespace gpa

@@ -1,0 +1,109 @@
+#pragma once
+// Typed views of the node fields that each driver reads and writes. A driver's signature names
+// its view, so its data dependencies are visible; the views are made from a NodeStore by the
+// functions below, or by hand in an embedding program with its own storage.
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+
+#include "gpa/engine/kernels.hpp"
+#include "gpa/engine/node_store.hpp"
+#include "gpa/engine/weights.hpp"
+
+namespace gpa {
+
+// What the pair kernel reads: positions, diameters (for h_ij), connectivity and body (for the
+// choice of R_ij, spec section 2 "Mixed pairs" and "Different bodies").
+template <int D>
+struct PairFields {
+    std::array<const double*, D> position{};
+    const double* diameter = nullptr;
+    const Connectivity* connectivity = nullptr;
+    const std::int32_t* body = nullptr;
+    double influence_distance = 1.0;
+
+    Vec<D> x(std::size_t i) const {
+        Vec<D> p;
+        for (int c = 0; c < D; ++c) p[c] = position[c][i];
+        return p;
+    }
+
+    // Pair geometry of centre i and neighbour j. A fixed-connectivity centre uses R = 1 for its
+    // lattice neighbours (same body); every other pair uses the variable weight (Eq. 1b or 62-65).
+    // r = 0 (coincident nodes) is returned as is; the drivers report it.
+    template <class VariableWeight>
+    PairGeometry<D> pair(std::size_t i, std::size_t j) const {
+        PairGeometry<D> p;
+        Vec<D> dx;
+        for (int c = 0; c < D; ++c) dx[c] = position[c][j] - position[c][i];
+        p.r = dx.norm();
+        p.l = dx / p.r;
+        p.h = pair_smoothing_length(influence_distance, diameter[i], diameter[j]);
+        const bool lattice_pair = connectivity[i] == Connectivity::Fixed && body[i] == body[j];
+        p.R = lattice_pair ? fixed_pair_weight : VariableWeight::value(p.r / p.h);
+        return p;
+    }
+};
+
+template <int D>
+struct GradientFields {
+    PairFields<D> pairs;
+    std::array<const double*, D> velocity{};
+    const double* size_weight = nullptr;  // W_j
+    // outputs, one value per centre
+    std::array<double*, D> alpha{};
+    std::array<double*, D * D> velocity_gradient{};  // L_ab at [a * D + b]
+    double* volumetric_strain_rate = nullptr;
+    double* smallest_h = nullptr;
+};
+
+template <int D>
+struct ForceFields {
+    PairFields<D> pairs;
+    const double* volume = nullptr;       // V_i
+    const double* size_weight = nullptr;  // W_j
+    std::array<const double*, D> alpha{};
+    std::array<const double*, 6> deviatoric_stress{};
+    const double* pressure = nullptr;
+    const double* viscous_pressure = nullptr;  // nodal Q_i; nullptr when there is none
+    // read by bond viscosity only
+    std::array<const double*, D> velocity{};
+    const double* mass = nullptr;
+    const double* sound_speed = nullptr;
+    // outputs
+    std::array<double*, D> force{};
+    double* bond_viscous_power = nullptr;  // per centre, optional: the power of its bond-viscous forces
+    std::size_t hoop_count = 0;            // centres [0, hoop_count) feel their hoop stress
+};
+
+// Cauchy stress sigma = s - (P + Q) I of node i: the in-plane (or full 3D) part.
+template <class G>
+inline Mat<G::dim> cauchy_stress(const std::array<const double*, 6>& s, const double* pressure,
+                                 const double* viscous_pressure, std::size_t i) {
+    const double p = pressure[i] + (viscous_pressure ? viscous_pressure[i] : 0.0);
+    Mat<G::dim> sigma;
+    if constexpr (G::dim == 2) {
+        sigma << s[0][i] - p, s[2][i], s[2][i], s[1][i] - p;
+    } else {
+        sigma << s[0][i] - p, s[5][i], s[4][i],  //
+            s[5][i], s[1][i] - p, s[3][i],        //
+            s[4][i], s[3][i], s[2][i] - p;
+    }
+    return sigma;
+}
+
+// The out-of-plane (hoop) Cauchy stress of a 2D node, sigma_theta = s_tt - (P + Q).
+inline double out_of_plane_stress(const std::array<const double*, 6>& s, const double* pressure,
+                                  const double* viscous_pressure, std::size_t i) {
+    return s[3][i] - pressure[i] - (viscous_pressure ? viscous_pressure[i] : 0.0);
+}
+
+template <int D>
+PairFields<D> pair_fields(const NodeStore& nodes, double influence_distance);
+template <int D>
+GradientFields<D> gradient_fields(NodeStore& nodes, double influence_distance);
+template <int D>
+ForceFields<D> force_fields(NodeStore& nodes, double influence_distance);
+
+}  // namespace gpa

@@ -1,0 +1,122 @@
+#pragma once
+// The pairwise and per-node kernels of the Generalized Particle Algorithm as small pure
+// functions. They see neither threads nor storage: the drivers in gradient.hpp and forces.hpp
+// apply them over the neighbour lists. Equation numbers are those of Johnson, Beissel and Stryk
+// (Comput. Mech. 25, 2000), restated in shared/spec/gpa-method.md.
+
+#include <cmath>
+
+#include <Eigen/Core>
+
+#include "gpa/engine/geometry.hpp"
+
+namespace gpa {
+
+template <int D>
+using Vec = Eigen::Matrix<double, D, 1>;
+template <int D>
+using Mat = Eigen::Matrix<double, D, D>;
+
+// What one pair (centre i, neighbour j) contributes to both the gradient and the force
+// kernels. Computed by one function so that both use the same numbers.
+template <int D>
+struct PairGeometry {
+    Vec<D> l;      // unit vector from i to j
+    double r;      // |x_j - x_i|
+    double h;      // h_ij (Eq. 2)
+    double R;      // distance weight R_ij (Eq. 1a, 1b, or 62-65)
+};
+
+// Running sums of the gradient gather for one centre node.
+template <int D>
+struct GradientSums {
+    Vec<D> moment = Vec<D>::Zero();     // sum_j R W l_b^2, the inverse of alpha_b (Eq. 14, 15, 51-53)
+    Mat<D> difference = Mat<D>::Zero(); // sum_j R W (v_a(j) - v_a(i)) l_b / r
+    double smallest_h = INFINITY;
+};
+
+// Eq. 7-8, 10-11, 14-15, 42-53: one neighbour's contribution to the geometry factors and to
+// the velocity gradient L_ab = alpha_b sum_j R W (v_a(j) - v_a(i)) l_b / r.
+template <int D>
+inline void accumulate_gradient(const PairGeometry<D>& p, double size_weight_j, const Vec<D>& dv,
+                                GradientSums<D>& sums) {
+    const double rw = p.R * size_weight_j;
+    sums.moment += rw * p.l.cwiseProduct(p.l);
+    sums.difference.noalias() += (rw / p.r) * dv * p.l.transpose();
+    sums.smallest_h = std::fmin(sums.smallest_h, p.h);
+}
+
+// Geometry factors alpha_b = 1 / sum_j R W l_b^2 and L_ab = alpha_b * difference_ab.
+template <int D>
+inline Mat<D> velocity_gradient(const GradientSums<D>& sums, const Vec<D>& alpha) {
+    return sums.difference * alpha.asDiagonal();
+}
+
+// Eq. 12: eps_v_dot = D_xx + D_zz (+ u/x in axisymmetric geometry, Eq. 9) or the trace in 3D.
+template <class G>
+inline double volumetric_strain_rate(const Mat<G::dim>& L, double radial_velocity, double radius) {
+    double rate = L.trace();
+    if constexpr (G::axisymmetric) rate += radial_velocity / radius;
+    return rate;
+}
+
+// Eq. 21-22, 54-56: the force that centre i's stress exerts on neighbour j,
+//   P_a(ij) = - R V_i W_j / r * sum_b alpha_b(i) (sigma_ab(i) - Q_ij delta_ab) l_b.
+// sigma is the in-plane Cauchy stress of i including its nodal viscosity; Q_ij is the bond
+// viscosity (0 without it). The reaction -P(ij) acts on i (Eq. 23-24).
+template <int D>
+inline Vec<D> pair_force(const PairGeometry<D>& p, double volume_i, double size_weight_j,
+                         const Vec<D>& alpha_i, const Mat<D>& sigma_i, double bond_q) {
+    const Vec<D> scaled_l = alpha_i.cwiseProduct(p.l);
+    return (-p.R * volume_i * size_weight_j / p.r) * (sigma_i * scaled_l - bond_q * scaled_l);
+}
+
+// Eq. 23 (with Eq. 32 read as "+ P_hoop", see spec section 5): the hoop stress of an
+// axisymmetric ring pulls it towards the axis, P_x(ii) += - sigma_theta V_i / x_i.
+inline double hoop_force(double sigma_theta, double volume, double radius) {
+    return -sigma_theta * volume / radius;
+}
+
+// Eq. 38: mu_ij = h_ij (v_i - v_j).(x_i - x_j) / (r^2 + eps0 h_ij^2), with
+// (v_i - v_j).(x_i - x_j) = r (v_j - v_i).l.
+template <int D>
+inline double bond_compression_rate(const PairGeometry<D>& p, const Vec<D>& dv, double eps0) {
+    return p.h * p.r * dv.dot(p.l) / (p.r * p.r + eps0 * p.h * p.h);
+}
+
+// Eq. 37: Q_ij = C_L rho_i c_i |mu| + C_Q rho_i mu^2 for mu < 0, otherwise 0.
+inline double bond_viscosity(double mu, double density_i, double sound_speed_i, double c_linear,
+                             double c_quadratic) {
+    if (!(mu < 0.0)) return 0.0;
+    return density_i * (c_linear * sound_speed_i * (-mu) + c_quadratic * mu * mu);
+}
+
+// Eq. 36: Q_i = C_L rho c h |eps_v_dot| + C_Q rho h^2 eps_v_dot^2 for eps_v_dot < 0, else 0.
+inline double nodal_viscosity(double volumetric_strain_rate, double density, double sound_speed,
+                              double smallest_h, double c_linear, double c_quadratic) {
+    if (!(volumetric_strain_rate < 0.0)) return 0.0;
+    const double hr = smallest_h * volumetric_strain_rate;
+    return density * (c_linear * sound_speed * (-hr) + c_quadratic * hr * hr);
+}
+
+// Eq. 13: eps_v(t + dt) = eps_v(t) + eps_v_dot dt (1 + eps_v(t)), integrated in the initial
+// configuration; the volume follows as V = V0 (1 + eps_v).
+inline double advance_volumetric_strain(double eps_v, double rate, double dt) {
+    return eps_v + rate * dt * (1.0 + eps_v);
+}
+
+// Eq. 3 and its plane-strain and 3D analogues (spec section 2):
+//   axisymmetric d = d0 sqrt((1 + eps_v) x0 / x), plane strain d = d0 sqrt(1 + eps_v),
+//   3D d = d0 (1 + eps_v)^(1/3).
+template <class G>
+inline double node_diameter(double d0, double eps_v, double x0, double x) {
+    if constexpr (G::dim == 3) {
+        return d0 * std::cbrt(1.0 + eps_v);
+    } else if constexpr (G::axisymmetric) {
+        return d0 * std::sqrt((1.0 + eps_v) * x0 / x);
+    } else {
+        return d0 * std::sqrt(1.0 + eps_v);
+    }
+}
+
+}  // namespace gpa

@@ -1,0 +1,42 @@
+#pragma once
+// Filling bodies with nodes (spec section 12): a lattice of spacing (dx, dz) or dx = dy = dz in
+// 3D with nodes at cell centres, so that no node lies on a boundary, the axis or a plane; and
+// the lattice neighbours that fixed connectivity keeps (spec section 2).
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+
+#include "gpa/engine/node_store.hpp"
+
+namespace gpa {
+
+// Which lattice neighbours a fixed-connectivity node keeps.
+//   2D: 4 (along the axes) or 8 (with diagonals); 3D: 6 (faces), 18 (+ edges) or 26 (+ corners).
+int check_lattice_stencil(int dim, int neighbours);  // returns neighbours, or throws InputError
+
+struct LatticeBlock {
+    // Lattice cell k (integer, per axis) has its node at origin + (k + 1/2) * spacing.
+    std::array<double, 3> origin{0, 0, 0};
+    std::array<double, 3> spacing{1, 1, 1};   // 3D: all three equal
+    std::array<std::int64_t, 3> first{0, 0, 0};  // cells [first, last) per axis
+    std::array<std::int64_t, 3> last{1, 1, 1};
+    double density = 1.0;                        // rho0, kg/m^3
+    std::array<double, 3> velocity{0, 0, 0};     // initial velocity of every node, m/s
+    std::int32_t body = 0;
+    std::int32_t material = 0;
+    Connectivity connectivity = Connectivity::Variable;
+    int lattice_neighbours = 8;                  // stencil of the fixed lists (see above)
+    // Keeps the cells whose centre it accepts (x, z) or (x, y, z); empty: keep all.
+    std::function<bool(const std::array<double, 3>&)> inside;
+};
+
+// Appends the block's nodes to `nodes`, with mass, volume, size weight, diameter (d0 = sqrt(dx dz)
+// in 2D, dx in 3D), x0, velocity, body, material and connectivity set, and fixed lists that link
+// each new node to its stencil neighbours among the new nodes. Returns the index of the first
+// new node. Throws InputError for a non-positive spacing or density or (axisymmetric) a cell
+// centre at x <= 0.
+std::size_t fill_lattice(NodeStore& nodes, const LatticeBlock& block);
+
+}  // namespace gpa

@@ -1,0 +1,68 @@
+#pragma once
+// Neighbour lists (spec section 2): fixed connectivity keeps the lattice neighbours of the
+// initial configuration; variable connectivity finds, with a cell list, all nodes within the
+// radius of influence 2 h_ij. A fixed-connectivity centre also finds the nodes of other bodies
+// within 2 h_ij, because bodies interact only through such pairs.
+
+#include <array>
+#include <cstddef>
+#include <vector>
+
+#include "gpa/engine/compressed_rows.hpp"
+#include "gpa/engine/node_store.hpp"
+
+namespace gpa {
+
+// Nodes sorted into the cells of a uniform grid (a stable counting sort, so each cell keeps
+// ascending node order).
+struct CellGrid {
+    int dim = 2;
+    double cell_size = 0.0;
+    std::array<double, 3> origin{0, 0, 0};
+    std::array<std::size_t, 3> cells{1, 1, 1};
+    std::vector<std::size_t> cell_start;  // cell k holds nodes[cell_start[k] .. cell_start[k+1])
+    std::vector<NodeIndex> nodes;
+
+    // Puts nodes [0, count) into cells no smaller than min_cell_size; the edge grows when the
+    // grid would have many more cells than nodes.
+    void build(const NodeStore& store, std::size_t count, double min_cell_size);
+    std::array<std::size_t, 3> cell_of(const NodeStore& store, std::size_t i) const;
+    std::size_t linear(const std::array<std::size_t, 3>& c) const {
+        return (c[2] * cells[1] + c[1]) * cells[0] + c[0];
+    }
+};
+
+// True when some centre in [0, centres) needs a search: a variable-connectivity centre, or more
+// than one body.
+bool needs_search(const NodeStore& nodes, std::size_t centres);
+
+// Reusable state of the search (the grid and per-block buffers), kept between steps.
+struct NeighbourScratch {
+    CellGrid grid;
+    std::vector<std::vector<NodeIndex>> block_indices;
+    std::vector<std::vector<std::size_t>> block_counts;
+};
+
+// The neighbour lists of centres [0, centres), drawn from all nodes [0, nodes.size()):
+//   a variable centre: every j != i with r_ij < 2 h_ij;
+//   a fixed centre: its lattice neighbours, then every node of another body with r_ij < 2 h_ij.
+// Deterministic and independent of the thread count. Validates a (0.8-1.5).
+void find_neighbours(const NodeStore& nodes, double influence_distance, std::size_t centres,
+                     CompressedRows& out, NeighbourScratch& scratch);
+CompressedRows find_neighbours(const NodeStore& nodes, double influence_distance, std::size_t centres);
+
+// The same lists from an all-pairs loop: the check for find_neighbours. O(n^2).
+CompressedRows find_neighbours_brute_force(const NodeStore& nodes, double influence_distance,
+                                           std::size_t centres);
+
+// A permutation (new_to_old, for NodeStore::permute) of nodes [first, last) that sorts them by
+// cell of a grid of the given edge, the longest axis varying slowest (so that slabs across it
+// are contiguous index ranges); nodes outside the
+// range keep their places.
+std::vector<NodeIndex> locality_order(const NodeStore& nodes, double cell_size, std::size_t first,
+                                      std::size_t last);
+
+// The largest interaction radius 2 a d_max over nodes [0, count).
+double largest_interaction_radius(const NodeStore& nodes, double influence_distance, std::size_t count);
+
+}  // namespace gpa

@@ -1,0 +1,87 @@
+#pragma once
+// Node storage as structure of arrays: one contiguous array per field, so that a kernel
+// touches only the fields it reads and writes (spec: "NodeStore").
+//
+// Vector fields hold one array per component; in 2D only components 0 (x) and 1 (z) are
+// allocated. Stress components follow the order given in geometry.hpp.
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "gpa/engine/compressed_rows.hpp"
+#include "gpa/engine/geometry.hpp"
+
+namespace gpa {
+
+enum class Connectivity : std::uint8_t { Fixed = 0, Variable = 1 };
+
+class NodeStore {
+public:
+    explicit NodeStore(GeometryKind geometry, std::size_t count = 0);
+
+    GeometryKind geometry() const { return geometry_; }
+    int dim() const { return dim_; }
+    std::size_t size() const { return mass.size(); }
+
+    // Changes the node count; new nodes have every field zero (connectivity Fixed, body and
+    // material 0) and no fixed neighbours.
+    void resize(std::size_t count);
+
+    // Reorders every per-node field so that new node k is old node new_to_old[k], and rewrites
+    // the fixed neighbour lists in the new numbering. new_to_old must be a permutation.
+    void permute(std::span<const NodeIndex> new_to_old);
+
+    // --- state carried from step to step -------------------------------------------------
+    std::array<std::vector<double>, 3> position;   // m
+    std::array<std::vector<double>, 3> velocity;   // m/s
+    std::vector<double> mass;                      // kg (a ring's mass in axisymmetric geometry)
+    std::vector<double> volume;                    // V, m^3 (unit thickness in plane strain)
+    std::vector<double> initial_volume;            // V0
+    std::vector<double> size_weight;               // W_j: A_j in 2D (Eq. 4), V_j in 3D
+    std::vector<double> diameter;                  // d (Eq. 3)
+    std::vector<double> initial_diameter;          // d0
+    std::vector<double> initial_radius;            // x0, axisymmetric only (Eq. 3)
+    std::vector<double> volumetric_strain;         // eps_v = V/V0 - 1 (Eq. 13)
+    std::array<std::vector<double>, 6> deviatoric_stress;  // s, Pa
+    std::vector<double> pressure;                  // P from the equation of state, Pa
+    std::vector<double> viscous_pressure;          // nodal artificial viscosity Q_i (Eq. 36), Pa
+    std::vector<double> sound_speed;               // longitudinal wave speed c_i, m/s
+    std::vector<double> internal_energy;           // specific, J/kg
+    std::vector<double> temperature;               // K
+    std::vector<double> plastic_strain;            // equivalent plastic strain
+    std::vector<double> damage;                    // Johnson-Cook damage D
+    std::vector<std::int32_t> body;
+    std::vector<std::int32_t> material;
+    std::vector<Connectivity> connectivity;
+
+    // --- results of the gradient and force phases, rewritten every step ------------------
+    std::array<std::vector<double>, 3> alpha;              // geometry factors (Eq. 14, 15, 51-53)
+    std::array<std::vector<double>, 9> velocity_gradient;  // L_ab at [a * dim + b]
+    std::vector<double> volumetric_strain_rate;            // eps_v_dot (Eq. 12), with hoop term
+    std::vector<double> smallest_h;                        // min_j h_ij
+    std::array<std::vector<double>, 3> force;              // N (a ring's force in axisymmetric)
+
+    // Lattice neighbours of each node for fixed connectivity (spec section 2).
+    CompressedRows fixed_neighbours;
+
+private:
+    template <class F>
+    void for_each_field(F&& f);
+
+    GeometryKind geometry_;
+    int dim_;
+};
+
+// Checks what the method cannot work with, for nodes [first, last): a non-finite or (in
+// axisymmetric geometry) non-positive radial coordinate, a non-positive mass, volume, size
+// weight or diameter, a non-finite velocity. Throws InputError naming the node and its position.
+void validate_nodes(const NodeStore& nodes, std::size_t first, std::size_t last);
+inline void validate_nodes(const NodeStore& nodes) { validate_nodes(nodes, 0, nodes.size()); }
+
+// Sets W_j from the current volume and position: V/(2 pi x) axisymmetric, V otherwise.
+void update_size_weights(NodeStore& nodes, std::size_t first, std::size_t last);
+
+}  // namespace gpa

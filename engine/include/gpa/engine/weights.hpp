@@ -1,0 +1,60 @@
+#pragma once
+// Distance weights R_ij of the method (spec section 2 and 8). The normalisation by the geometry
+// factors alpha removes any constant factor of R, so only R's shape matters.
+
+namespace gpa {
+
+// The weight used by variable-connectivity pairs; fixed pairs always use R = 1 (Eq. 1a).
+enum class WeightKind {
+    Gpa,     // R = 1 - v/2 (Eq. 1b)
+    SphNsf,  // R = -r W'(r, h) of a cubic-spline kernel (Eq. 62-65)
+};
+
+// Eq. 1a: fixed connectivity.
+inline constexpr double fixed_pair_weight = 1.0;
+
+// Eq. 1b: R = 1 - v/2 for v = r/h in [0, 2), zero beyond (a neighbour at exactly 2h has weight 0).
+struct GpaWeight {
+    static constexpr WeightKind kind = WeightKind::Gpa;
+    static double value(double v) { return v < 2.0 ? 1.0 - 0.5 * v : 0.0; }
+};
+
+// Eq. 62-65: SPH with normalised smoothing functions is GPA with R = -r dW/dr. For the cubic
+// spline W(q) ~ 1 - 3/2 q^2 + 3/4 q^3 (q < 1), 1/4 (2 - q)^3 (1 <= q < 2), q = r/h, this is
+// R = 3 q^2 - 9/4 q^3 (q < 1) and R = 3/4 q (2 - q)^2 (1 <= q < 2), up to the kernel's constant.
+struct SphNsfWeight {
+    static constexpr WeightKind kind = WeightKind::SphNsf;
+    static double value(double q) {
+        if (q < 1.0) return q * q * (3.0 - 2.25 * q);
+        if (q < 2.0) {
+            const double t = 2.0 - q;
+            return 0.75 * q * t * t;
+        }
+        return 0.0;
+    }
+};
+
+// Calls f(weight tag) for a run-time weight kind, once, outside any inner loop.
+template <class F>
+decltype(auto) dispatch_weight(WeightKind kind, F&& f) {
+    if (kind == WeightKind::SphNsf) return f(SphNsfWeight{});
+    return f(GpaWeight{});
+}
+
+// The one neighbour rule used by the search, the brute-force check and every count:
+// j is a neighbour of i when r_ij < 2 h_ij (spec section 2).
+inline bool within_influence(double r_squared, double h) { return r_squared < 4.0 * h * h; }
+
+// Eq. 2: h_ij = a (d_i + d_j) / 2.
+inline double pair_smoothing_length(double influence_distance, double d_i, double d_j) {
+    return influence_distance * 0.5 * (d_i + d_j);
+}
+
+// The range of the dimensionless influence distance a the method is defined for (spec section 2).
+inline constexpr double min_influence_distance = 0.8;
+inline constexpr double max_influence_distance = 1.5;
+
+// Throws InputError when a is outside [0.8, 1.5] or not finite.
+void check_influence_distance(double influence_distance);
+
+}  // namespace gpa

@@ -1,0 +1,215 @@
+#include "gpa/engine/drivers.hpp"
+
+#include <atomic>
+#include <cstdint>
+#include <limits>
+
+#include <fmt/format.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include "gpa/engine/errors.hpp"
+
+namespace gpa {
+
+namespace {
+
+constexpr std::size_t no_node = std::numeric_limits<std::size_t>::max();
+
+void record_smallest(std::atomic<std::size_t>& slot, std::size_t i) {
+    std::size_t seen = slot.load(std::memory_order_relaxed);
+    while (i < seen && !slot.compare_exchange_weak(seen, i, std::memory_order_relaxed)) {
+    }
+}
+
+template <int D>
+Vec<D> load(const std::array<const double*, D>& field, std::size_t i) {
+    Vec<D> v;
+    for (int c = 0; c < D; ++c) v[c] = field[c][i];
+    return v;
+}
+
+template <int D>
+std::string describe(const PairFields<D>& p, std::size_t i) {
+    const Vec<D> x = p.x(i);
+    if constexpr (D == 2) {
+        return fmt::format("node {} at (x, z) = ({:.6g}, {:.6g}) m", i, x[0], x[1]);
+    } else {
+        return fmt::format("node {} at (x, y, z) = ({:.6g}, {:.6g}, {:.6g}) m", i, x[0], x[1], x[2]);
+    }
+}
+
+// Re-examines the centre the parallel loop flagged and throws the error that says why.
+template <class G, class W>
+[[noreturn]] void report_gradient_failure(const CompressedRows& lists, const GradientFields<G::dim>& f,
+                                          std::size_t i) {
+    constexpr int D = G::dim;
+    const auto row = lists.row(i);
+    if (row.empty()) {
+        throw InputError(fmt::format(
+            "{} has an empty neighbourhood: its geometry factors (Eq. 14-15) are undefined. Give it "
+            "neighbours (a node needs others within 2 h_ij, or lattice neighbours under fixed "
+            "connectivity)",
+            describe(f.pairs, i)));
+    }
+    GradientSums<D> sums;
+    for (NodeIndex j : row) {
+        const auto p = f.pairs.template pair<W>(i, j);
+        if (!(p.r > 0.0)) {
+            throw NumericalError(fmt::format("{} and node {} coincide (r_ij = {}): the unit vector "
+                                             "between them is undefined",
+                                             describe(f.pairs, i), j, p.r));
+        }
+        accumulate_gradient(p, f.size_weight[j], Vec<D>::Zero().eval(), sums);
+    }
+    static constexpr const char* axis2[] = {"x", "z"};
+    static constexpr const char* axis3[] = {"x", "y", "z"};
+    for (int b = 0; b < D; ++b) {
+        if (!(sums.moment[b] > 0.0)) {
+            throw InputError(fmt::format(
+                "{} has {} neighbours but none that weighs along {} (sum R W l^2 = {}): the geometry "
+                "factor alpha_{} (Eq. 14-15) is undefined; its neighbourhood is flat or its weights "
+                "are zero",
+                describe(f.pairs, i), row.size(), D == 2 ? axis2[b] : axis3[b], sums.moment[b],
+                D == 2 ? axis2[b] : axis3[b]));
+        }
+    }
+    throw NumericalError(fmt::format("{}: the velocity gradient is not finite", describe(f.pairs, i)));
+}
+
+template <class G, class W>
+void gradient_impl(const CompressedRows& lists, const GradientFields<G::dim>& f) {
+    constexpr int D = G::dim;
+    const std::size_t n = lists.rows();
+    std::atomic<std::size_t> first_bad{no_node};
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 256), [&](const tbb::blocked_range<std::size_t>& range) {
+        for (std::size_t i = range.begin(); i != range.end(); ++i) {
+            const Vec<D> v_i = load<D>(f.velocity, i);
+            GradientSums<D> sums;
+            bool ok = true;
+            for (NodeIndex j : lists.row(i)) {
+                const auto p = f.pairs.template pair<W>(i, j);
+                ok &= p.r > 0.0;
+                accumulate_gradient(p, f.size_weight[j], (load<D>(f.velocity, j) - v_i).eval(), sums);
+            }
+            // Eq. 14-15, 51-53: alpha_b = 1 / sum_j R W l_b^2.
+            const Vec<D> alpha = sums.moment.cwiseInverse();
+            for (int b = 0; b < D; ++b) ok &= sums.moment[b] > 0.0;
+            const Mat<D> L = velocity_gradient(sums, alpha);
+            ok &= L.allFinite();
+            if (!ok) {
+                record_smallest(first_bad, i);
+                continue;
+            }
+            for (int b = 0; b < D; ++b) f.alpha[b][i] = alpha[b];
+            for (int a = 0; a < D; ++a) {
+                for (int b = 0; b < D; ++b) f.velocity_gradient[a * D + b][i] = L(a, b);
+            }
+            f.volumetric_strain_rate[i] = volumetric_strain_rate<G>(L, v_i[0], f.pairs.position[0][i]);
+            f.smallest_h[i] = sums.smallest_h;
+        }
+    });
+    if (const std::size_t bad = first_bad.load(); bad != no_node) report_gradient_failure<G, W>(lists, f, bad);
+}
+
+template <class G, class W, bool with_bond_viscosity>
+void forces_impl(const CompressedRows& lists, const ScatterPlan& plan, const BondViscosityParameters& bond,
+                 const ForceFields<G::dim>& f, std::size_t node_count) {
+    constexpr int D = G::dim;
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, node_count, 4096),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                          for (int c = 0; c < D; ++c) {
+                              std::fill(f.force[c] + r.begin(), f.force[c] + r.end(), 0.0);
+                          }
+                      });
+
+    const auto centre = [&](std::size_t i) {
+        const Mat<D> sigma = cauchy_stress<G>(f.deviatoric_stress, f.pressure, f.viscous_pressure, i);
+        const Vec<D> alpha = load<D>(f.alpha, i);
+        const double volume = f.volume[i];
+        Vec<D> on_centre = Vec<D>::Zero();
+        [[maybe_unused]] Vec<D> v_i;
+        [[maybe_unused]] double density = 0.0, sound_speed = 0.0, bond_power = 0.0;
+        if constexpr (with_bond_viscosity) {
+            v_i = load<D>(f.velocity, i);
+            density = f.mass[i] / volume;
+            sound_speed = f.sound_speed[i];
+        }
+        for (NodeIndex j : lists.row(i)) {
+            const auto p = f.pairs.template pair<W>(i, j);
+            double q = 0.0;
+            [[maybe_unused]] Vec<D> dv;
+            if constexpr (with_bond_viscosity) {
+                dv = load<D>(f.velocity, j) - v_i;
+                const double mu = bond_compression_rate(p, dv, bond.eps0);  // Eq. 38
+                q = bond_viscosity(mu, density, sound_speed, bond.linear, bond.quadratic);  // Eq. 37
+            }
+            const Vec<D> force_on_j = pair_force(p, volume, f.size_weight[j], alpha, sigma, q);  // Eq. 21-22
+            for (int c = 0; c < D; ++c) f.force[c][j] += force_on_j[c];
+            on_centre -= force_on_j;  // Eq. 23-24
+            if constexpr (with_bond_viscosity) {
+                // The work rate of the -Q_ij part of this pair's force (spec section 5).
+                bond_power += p.R * volume * f.size_weight[j] * q / p.r * alpha.cwiseProduct(p.l).dot(dv);
+            }
+        }
+        if constexpr (G::axisymmetric) {
+            if (i < f.hoop_count) {
+                on_centre[0] += hoop_force(out_of_plane_stress(f.deviatoric_stress, f.pressure, f.viscous_pressure, i),
+                                           volume, f.pairs.position[0][i]);
+            }
+        }
+        for (int c = 0; c < D; ++c) f.force[c][i] += on_centre[c];
+        if constexpr (with_bond_viscosity) {
+            if (f.bond_viscous_power) f.bond_viscous_power[i] = bond_power;
+        }
+    };
+
+    for (std::size_t colour = 0; colour < plan.colours(); ++colour) {
+        tbb::parallel_for(
+            tbb::blocked_range<std::size_t>(plan.colour_offsets[colour], plan.colour_offsets[colour + 1], 1),
+            [&](const tbb::blocked_range<std::size_t>& groups) {
+                for (std::size_t g = groups.begin(); g != groups.end(); ++g) {
+                    for (NodeIndex i : plan.group(g)) centre(i);
+                }
+            });
+    }
+}
+
+}  // namespace
+
+template <class G>
+void compute_velocity_gradient(const CompressedRows& lists, WeightKind weight, const GradientFields<G::dim>& f) {
+    dispatch_weight(weight, [&](auto w) { gradient_impl<G, decltype(w)>(lists, f); });
+}
+
+template <class G>
+void compute_forces(const CompressedRows& lists, const ScatterPlan& plan, WeightKind weight,
+                    const BondViscosityParameters* bond, const ForceFields<G::dim>& f, std::size_t node_count) {
+    if (plan.centres.size() != lists.rows()) {
+        throw InputError(fmt::format("compute_forces: the scatter plan covers {} centres, the lists {}",
+                                     plan.centres.size(), lists.rows()));
+    }
+    dispatch_weight(weight, [&](auto w) {
+        using W = decltype(w);
+        if (bond) {
+            forces_impl<G, W, true>(lists, plan, *bond, f, node_count);
+        } else {
+            forces_impl<G, W, false>(lists, plan, BondViscosityParameters{}, f, node_count);
+        }
+    });
+}
+
+template void compute_velocity_gradient<PlaneStrain>(const CompressedRows&, WeightKind,
+                                                const GradientFields<PlaneStrain::dim>&);
+template void compute_forces<PlaneStrain>(const CompressedRows&, const ScatterPlan&, WeightKind,
+                                     const BondViscosityParameters*, const ForceFields<PlaneStrain::dim>&, std::size_t);
+template void compute_velocity_gradient<Axisymmetric>(const CompressedRows&, WeightKind,
+                                                const GradientFields<Axisymmetric::dim>&);
+template void compute_forces<Axisymmetric>(const CompressedRows&, const ScatterPlan&, WeightKind,
+                                     const BondViscosityParameters*, const ForceFields<Axisymmetric::dim>&, std::size_t);
+template void compute_velocity_gradient<ThreeD>(const CompressedRows&, WeightKind,
+                                                const GradientFields<ThreeD::dim>&);
+template void compute_forces<ThreeD>(const CompressedRows&, const ScatterPlan&, WeightKind,
+                                     const BondViscosityParameters*, const ForceFields<ThreeD::dim>&, std::size_t);
+
+}  // namespace gpa

@@ -1,0 +1,145 @@
+#include "gpa/engine/lattice.hpp"
+
+#include <cmath>
+#include <numbers>
+#include <unordered_map>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "gpa/engine/errors.hpp"
+
+namespace gpa {
+
+int check_lattice_stencil(int dim, int neighbours) {
+    const bool ok = dim == 2 ? (neighbours == 4 || neighbours == 8)
+                             : (neighbours == 6 || neighbours == 18 || neighbours == 26);
+    if (!ok) {
+        throw InputError(fmt::format("lattice neighbours = {} is not allowed in {}D (allowed: {})", neighbours, dim,
+                                     dim == 2 ? "4 or 8" : "6, 18 or 26"));
+    }
+    return neighbours;
+}
+
+namespace {
+
+// Lattice offsets of a stencil: those with 1 (4/6), up to 2 (8/18) or up to 3 (26) non-zero
+// components, in a fixed order.
+std::vector<std::array<int, 3>> stencil_offsets(int dim, int neighbours) {
+    const int max_nonzero = (neighbours == 4 || neighbours == 6) ? 1 : (neighbours == 18 ? 2 : 3);
+    std::vector<std::array<int, 3>> out;
+    const int zr = dim == 3 ? 1 : 0;
+    for (int dz = -zr; dz <= zr; ++dz) {
+        for (int dy = -1; dy <= 1; ++dy) {
+            for (int dx = -1; dx <= 1; ++dx) {
+                const int nonzero = (dx != 0) + (dy != 0) + (dz != 0);
+                if (nonzero == 0 || nonzero > max_nonzero) continue;
+                out.push_back({dx, dy, dz});
+            }
+        }
+    }
+    return out;
+}
+
+struct CellHash {
+    std::size_t operator()(const std::array<std::int64_t, 3>& k) const {
+        std::uint64_t h = 1469598103934665603ull;
+        for (auto v : k) h = (h ^ static_cast<std::uint64_t>(v)) * 1099511628211ull;
+        return static_cast<std::size_t>(h);
+    }
+};
+
+}  // namespace
+
+std::size_t fill_lattice(NodeStore& nodes, const LatticeBlock& block) {
+    const int dim = nodes.dim();
+    check_lattice_stencil(dim, block.lattice_neighbours);
+    for (int c = 0; c < dim; ++c) {
+        if (!(block.spacing[c] > 0.0) || !std::isfinite(block.spacing[c])) {
+            throw InputError(fmt::format("lattice spacing along axis {} is {} (must be positive)", c, block.spacing[c]));
+        }
+        if (block.last[c] < block.first[c]) {
+            throw InputError(fmt::format("lattice cells along axis {}: last {} < first {}", c, block.last[c], block.first[c]));
+        }
+    }
+    if (dim == 3 && !(block.spacing[0] == block.spacing[1] && block.spacing[1] == block.spacing[2])) {
+        throw InputError("a 3D lattice needs dx = dy = dz (spec section 12)");
+    }
+    if (!(block.density > 0.0) || !std::isfinite(block.density)) {
+        throw InputError(fmt::format("density {} must be positive", block.density));
+    }
+
+    // In 2D the lattice axes are (x, z) = components (0, 1); in 3D (x, y, z).
+    const double cell_area = block.spacing[0] * block.spacing[1];
+    const double cell_volume = dim == 3 ? cell_area * block.spacing[2] : cell_area;
+    const double d0 = dim == 3 ? block.spacing[0] : std::sqrt(cell_area);
+
+    const std::size_t first_new = nodes.size();
+    std::vector<std::array<std::int64_t, 3>> cells;
+    std::vector<std::array<double, 3>> centres;
+    const std::int64_t zlast = dim == 3 ? block.last[2] : block.first[2] + 1;
+    for (std::int64_t kz = block.first[2]; kz < zlast; ++kz) {
+        for (std::int64_t ky = block.first[1]; ky < block.last[1]; ++ky) {
+            for (std::int64_t kx = block.first[0]; kx < block.last[0]; ++kx) {
+                const std::array<std::int64_t, 3> k{kx, ky, kz};
+                std::array<double, 3> p{0, 0, 0};
+                for (int c = 0; c < dim; ++c) {
+                    p[c] = block.origin[c] + (static_cast<double>(k[c]) + 0.5) * block.spacing[c];
+                }
+                if (block.inside && !block.inside(p)) continue;
+                cells.push_back(k);
+                centres.push_back(p);
+            }
+        }
+    }
+
+    const std::size_t added = cells.size();
+    nodes.resize(first_new + added);
+    std::unordered_map<std::array<std::int64_t, 3>, NodeIndex, CellHash> index_of;
+    index_of.reserve(added);
+    for (std::size_t k = 0; k < added; ++k) {
+        const std::size_t i = first_new + k;
+        const auto& p = centres[k];
+        for (int c = 0; c < dim; ++c) {
+            nodes.position[c][i] = p[c];
+            nodes.velocity[c][i] = block.velocity[c];
+        }
+        double v0 = cell_volume;
+        if (nodes.geometry() == GeometryKind::Axisymmetric) {
+            if (!(p[0] > 0.0)) {
+                throw InputError(fmt::format(
+                    "axisymmetric lattice cell ({}, {}) has its centre at x = {} m; nodes must have x > 0",
+                    cells[k][0], cells[k][1], p[0]));
+            }
+            v0 = 2.0 * std::numbers::pi * p[0] * cell_area;  // a ring of cross-section dx dz
+        }
+        nodes.initial_volume[i] = v0;
+        nodes.volume[i] = v0;
+        nodes.mass[i] = block.density * v0;
+        nodes.initial_diameter[i] = d0;
+        nodes.diameter[i] = d0;
+        nodes.initial_radius[i] = p[0];
+        nodes.body[i] = block.body;
+        nodes.material[i] = block.material;
+        nodes.connectivity[i] = block.connectivity;
+        index_of.emplace(cells[k], static_cast<NodeIndex>(i));
+    }
+    update_size_weights(nodes, first_new, first_new + added);
+
+    // Fixed lists of the new nodes: their stencil neighbours that exist, in stencil order.
+    const auto offsets = stencil_offsets(dim, block.lattice_neighbours);
+    auto& rows = nodes.fixed_neighbours;
+    rows.offsets.resize(first_new + 1);
+    rows.indices.resize(rows.offsets.back());
+    for (std::size_t k = 0; k < added; ++k) {
+        for (const auto& o : offsets) {
+            // 2D offsets are (dx, dz) in components 0 and 1.
+            std::array<std::int64_t, 3> nb{cells[k][0] + o[0], cells[k][1] + o[1], cells[k][2] + o[2]};
+            if (const auto it = index_of.find(nb); it != index_of.end()) rows.indices.push_back(it->second);
+        }
+        rows.offsets.push_back(rows.indices.size());
+    }
+    return first_new;
+}
+
+}  // namespace gpa

@@ -1,0 +1,238 @@
+#include "gpa/engine/neighbours.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+
+#include <fmt/format.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include "gpa/engine/errors.hpp"
+#include "gpa/engine/weights.hpp"
+
+namespace gpa {
+
+namespace {
+
+constexpr std::size_t search_block = 1024;  // centres per task; fixed so lists never depend on threads
+
+double squared_distance(const NodeStore& s, std::size_t i, std::size_t j) {
+    double r2 = 0.0;
+    for (int c = 0; c < s.dim(); ++c) {
+        const double d = s.position[c][j] - s.position[c][i];
+        r2 += d * d;
+    }
+    return r2;
+}
+
+bool is_pair(const NodeStore& s, double a, std::size_t i, std::size_t j) {
+    return within_influence(squared_distance(s, i, j), pair_smoothing_length(a, s.diameter[i], s.diameter[j]));
+}
+
+}  // namespace
+
+double largest_interaction_radius(const NodeStore& nodes, double a, std::size_t count) {
+    double d_max = 0.0;
+    for (std::size_t i = 0; i < count; ++i) d_max = std::max(d_max, nodes.diameter[i]);
+    return 2.0 * a * d_max;
+}
+
+void CellGrid::build(const NodeStore& store, std::size_t count, double min_cell_size) {
+    dim = store.dim();
+    std::array<double, 3> hi{0, 0, 0};
+    origin = {0, 0, 0};
+    for (int c = 0; c < dim; ++c) {
+        origin[c] = std::numeric_limits<double>::infinity();
+        hi[c] = -std::numeric_limits<double>::infinity();
+        for (std::size_t i = 0; i < count; ++i) {
+            origin[c] = std::min(origin[c], store.position[c][i]);
+            hi[c] = std::max(hi[c], store.position[c][i]);
+        }
+        if (count == 0) origin[c] = hi[c] = 0.0;
+        if (!std::isfinite(origin[c]) || !std::isfinite(hi[c])) {
+            throw InputError(fmt::format("neighbour search: a node has a non-finite coordinate {}", c));
+        }
+    }
+    cell_size = min_cell_size > 0.0 ? min_cell_size : 1.0;
+    // Bound the grid by the node count: far-apart bodies must not make an enormous empty grid.
+    for (;;) {
+        double total = 1.0;
+        cells = {1, 1, 1};
+        for (int c = 0; c < dim; ++c) {
+            const double n = std::floor((hi[c] - origin[c]) / cell_size) + 1.0;
+            cells[c] = static_cast<std::size_t>(std::min(n, 1e12));
+            total *= n;
+        }
+        if (total <= 2.0 * static_cast<double>(count) + 64.0) break;
+        cell_size *= 1.25;
+    }
+    const std::size_t total = cells[0] * cells[1] * cells[2];
+    cell_start.assign(total + 1, 0);
+    std::vector<std::size_t> key(count);
+    for (std::size_t i = 0; i < count; ++i) {
+        key[i] = linear(cell_of(store, i));
+        ++cell_start[key[i] + 1];
+    }
+    std::partial_sum(cell_start.begin(), cell_start.end(), cell_start.begin());
+    nodes.resize(count);
+    std::vector<std::size_t> next(cell_start.begin(), cell_start.end() - 1);
+    for (std::size_t i = 0; i < count; ++i) nodes[next[key[i]]++] = static_cast<NodeIndex>(i);
+}
+
+std::array<std::size_t, 3> CellGrid::cell_of(const NodeStore& store, std::size_t i) const {
+    std::array<std::size_t, 3> c{0, 0, 0};
+    for (int k = 0; k < dim; ++k) {
+        const double f = std::floor((store.position[k][i] - origin[k]) / cell_size);
+        c[k] = f <= 0.0 ? 0 : std::min(cells[k] - 1, static_cast<std::size_t>(f));
+    }
+    return c;
+}
+
+bool needs_search(const NodeStore& nodes, std::size_t centres) {
+    for (std::size_t i = 0; i < centres; ++i) {
+        if (nodes.connectivity[i] == Connectivity::Variable) return true;
+    }
+    for (std::size_t i = 1; i < nodes.size(); ++i) {
+        if (nodes.body[i] != nodes.body[0]) return true;
+    }
+    return false;
+}
+
+void find_neighbours(const NodeStore& nodes, double a, std::size_t centres, CompressedRows& out,
+                     NeighbourScratch& scratch) {
+    check_influence_distance(a);
+    const std::size_t n = nodes.size();
+    if (centres > n) throw InputError(fmt::format("find_neighbours: {} centres of {} nodes", centres, n));
+    if (nodes.fixed_neighbours.rows() < centres) {
+        throw InputError(fmt::format("find_neighbours: fixed lists cover {} of {} centres",
+                                     nodes.fixed_neighbours.rows(), centres));
+    }
+    const bool search = needs_search(nodes, centres);
+    if (search) scratch.grid.build(nodes, n, largest_interaction_radius(nodes, a, n));
+    const CellGrid& grid = scratch.grid;
+    const int dim = nodes.dim();
+
+    const std::size_t blocks = (centres + search_block - 1) / search_block;
+    scratch.block_indices.resize(blocks);
+    scratch.block_counts.resize(blocks);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, blocks, 1), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t b = r.begin(); b != r.end(); ++b) {
+            auto& indices = scratch.block_indices[b];
+            auto& counts = scratch.block_counts[b];
+            indices.clear();
+            counts.clear();
+            const std::size_t first = b * search_block, last = std::min(centres, first + search_block);
+            for (std::size_t i = first; i < last; ++i) {
+                const std::size_t before = indices.size();
+                const bool fixed = nodes.connectivity[i] == Connectivity::Fixed;
+                if (fixed) {
+                    const auto row = nodes.fixed_neighbours.row(i);
+                    indices.insert(indices.end(), row.begin(), row.end());
+                }
+                if (search) {
+                    const auto home = grid.cell_of(nodes, i);
+                    std::array<std::size_t, 3> lo{0, 0, 0}, hi{0, 0, 0};
+                    for (int k = 0; k < dim; ++k) {
+                        lo[k] = home[k] == 0 ? 0 : home[k] - 1;
+                        hi[k] = std::min(grid.cells[k] - 1, home[k] + 1);
+                    }
+                    const std::int32_t own_body = nodes.body[i];
+                    std::array<std::size_t, 3> c{0, 0, 0};
+                    for (c[2] = lo[2]; c[2] <= hi[2]; ++c[2]) {
+                        for (c[1] = lo[1]; c[1] <= hi[1]; ++c[1]) {
+                            for (c[0] = lo[0]; c[0] <= hi[0]; ++c[0]) {
+                                const std::size_t cell = grid.linear(c);
+                                for (std::size_t k = grid.cell_start[cell]; k < grid.cell_start[cell + 1]; ++k) {
+                                    const NodeIndex j = grid.nodes[k];
+                                    if (j == i || (fixed && nodes.body[j] == own_body)) continue;
+                                    if (is_pair(nodes, a, i, j)) indices.push_back(j);
+                                }
+                            }
+                        }
+                    }
+                }
+                counts.push_back(indices.size() - before);
+            }
+        }
+    });
+
+    out.offsets.resize(centres + 1);
+    out.offsets[0] = 0;
+    std::size_t i = 0;
+    for (std::size_t b = 0; b < blocks; ++b) {
+        for (std::size_t count : scratch.block_counts[b]) {
+            out.offsets[i + 1] = out.offsets[i] + count;
+            ++i;
+        }
+    }
+    out.indices.resize(out.offsets[centres]);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, blocks, 1), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t b = r.begin(); b != r.end(); ++b) {
+            const auto& src = scratch.block_indices[b];
+            std::copy(src.begin(), src.end(), out.indices.begin() + out.offsets[b * search_block]);
+        }
+    });
+}
+
+CompressedRows find_neighbours(const NodeStore& nodes, double a, std::size_t centres) {
+    CompressedRows out;
+    NeighbourScratch scratch;
+    find_neighbours(nodes, a, centres, out, scratch);
+    return out;
+}
+
+CompressedRows find_neighbours_brute_force(const NodeStore& nodes, double a, std::size_t centres) {
+    check_influence_distance(a);
+    std::vector<std::vector<NodeIndex>> rows(centres);
+    for (std::size_t i = 0; i < centres; ++i) {
+        const bool fixed = nodes.connectivity[i] == Connectivity::Fixed;
+        if (fixed) {
+            const auto row = nodes.fixed_neighbours.row(i);
+            rows[i].assign(row.begin(), row.end());
+        }
+        for (std::size_t j = 0; j < nodes.size(); ++j) {
+            if (j == i || (fixed && nodes.body[j] == nodes.body[i])) continue;
+            if (is_pair(nodes, a, i, j)) rows[i].push_back(static_cast<NodeIndex>(j));
+        }
+    }
+    return make_compressed_rows(rows);
+}
+
+std::vector<NodeIndex> locality_order(const NodeStore& nodes, double cell_size, std::size_t first, std::size_t last) {
+    const std::size_t n = nodes.size();
+    std::vector<NodeIndex> order(n);
+    std::iota(order.begin(), order.end(), NodeIndex{0});
+    if (last <= first + 1) return order;
+    const int dim = nodes.dim();
+    std::array<double, 3> lo{0, 0, 0}, hi{0, 0, 0};
+    for (int c = 0; c < dim; ++c) {
+        const auto [mn, mx] = std::minmax_element(nodes.position[c].begin() + first, nodes.position[c].begin() + last);
+        lo[c] = *mn;
+        hi[c] = *mx;
+    }
+    int slowest = 0;
+    for (int c = 1; c < dim; ++c) {
+        if (hi[c] - lo[c] > hi[slowest] - lo[slowest]) slowest = c;
+    }
+    std::array<int, 3> axes{0, 1, 2};  // fastest to slowest
+    std::rotate(axes.begin(), axes.begin() + slowest + 1, axes.begin() + dim);
+    const double edge = cell_size > 0.0 ? cell_size : 1.0;
+    std::vector<std::pair<std::uint64_t, NodeIndex>> keyed(last - first);
+    for (std::size_t i = first; i < last; ++i) {
+        std::uint64_t key = 0;
+        for (int k = dim - 1; k >= 0; --k) {
+            const int c = axes[k];
+            const double span = std::floor((hi[c] - lo[c]) / edge) + 1.0;
+            const auto cell = static_cast<std::uint64_t>(std::floor((nodes.position[c][i] - lo[c]) / edge));
+            key = key * static_cast<std::uint64_t>(std::min(span, 2.0e6)) + std::min<std::uint64_t>(cell, 1999999);
+        }
+        keyed[i - first] = {key, static_cast<NodeIndex>(i)};
+    }
+    std::stable_sort(keyed.begin(), keyed.end(), [](const auto& p, const auto& q) { return p.first < q.first; });
+    for (std::size_t k = 0; k < keyed.size(); ++k) order[first + k] = keyed[k].second;
+    return order;
+}
+
+}  // namespace gpa

@@ -1,0 +1,40 @@
+#pragma once
+// Test set-ups shared by the engine tests: regular and jittered lattices, random node states.
+
+#include <cstddef>
+#include <cstdint>
+#include <random>
+
+#include "gpa/engine/lattice.hpp"
+#include "gpa/engine/node_store.hpp"
+
+namespace gpa::testing {
+
+struct LatticeOptions {
+    GeometryKind geometry = GeometryKind::PlaneStrain;
+    int cells = 12;              // per axis
+    double spacing = 1.0;
+    double x_origin = 0.0;       // lower corner along x (axisymmetric: 0 puts the first column at dx/2)
+    Connectivity connectivity = Connectivity::Variable;
+    int lattice_neighbours = 0;  // 0: 8 in 2D, 26 in 3D
+    double density = 1.0;
+};
+
+NodeStore make_lattice(const LatticeOptions& o);
+
+// Moves every node by a uniform random offset in [-amplitude, amplitude] * spacing per axis and
+// updates the axisymmetric size weights. Diameters keep their lattice value.
+void jitter(NodeStore& nodes, double amplitude, double spacing, std::uint64_t seed);
+
+// Scales every diameter by a random factor in [1 - spread, 1 + spread].
+void vary_diameters(NodeStore& nodes, double spread, std::uint64_t seed);
+
+// Random stresses (every component), pressures, nodal viscous pressures, velocities and sound
+// speeds in ranges that make every term matter.
+void randomise_state(NodeStore& nodes, std::uint64_t seed);
+
+// Distance from node i to the nearest edge of the lattice box (and to the axis in
+// axisymmetric geometry), for selecting complete neighbourhoods.
+double distance_to_boundary(const NodeStore& nodes, const LatticeOptions& o, std::size_t i);
+
+}  // namespace gpa::testing
