@@ -1,0 +1,134 @@
+#pragma once
+// A scene: everything a run needs, as a plain C++ value. io/ turns scene files into one; an
+// embedding program can build one in code. All quantities SI.
+//
+// Coordinates follow the engine: in 2D, component 0 is x (radial in axisymmetric geometry) and
+// component 1 is z (axial); in 3D, (x, y, z). Arrays of 3 use the first dim entries.
+
+#include <array>
+#include <cstddef>
+#include <limits>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "gpa/engine/colouring.hpp"
+#include "gpa/engine/geometry.hpp"
+#include "gpa/engine/weights.hpp"
+#include "gpa/materials/material.hpp"
+
+namespace gpa {
+
+enum class ConnectivityMode {
+    Fixed,      // lattice neighbours for the whole run
+    Variable,   // all nodes within 2 h_ij, re-found every step
+    Automatic,  // start fixed, switch a node to variable when its plastic strain exceeds a threshold
+};
+
+enum class ViscosityKind { None, Nodal, Bond };
+
+enum class SmoothingMode {
+    Off,
+    Everywhere,  // every node is a smoothing centre
+    Tension,     // only nodes with negative pressure (paper section 7)
+};
+
+enum class ShapeKind {
+    Cylinder,   // axis along z. Axisymmetric: on the axis, x in (0, radius). Plane strain: x in
+                // (x0 - radius, x0 + radius). 3D: a circular cylinder around (x0, y0).
+    Plate,      // the same as a cylinder (a short, wide one); kept as its own word for scenes
+    Rectangle,  // 2D: x in (x0, x0 + size_x), z in (z0, z0 + size_z)
+    Box,        // 3D: a box from origin to origin + size
+    Sphere,     // centre `origin`, `radius` (a disc in plane strain; a sphere on the axis in axisymmetric)
+};
+
+struct BodySpec {
+    std::string name;
+    ShapeKind shape = ShapeKind::Cylinder;
+    // Cylinder/plate: origin is the centre of the base (lower z end); Rectangle/box: lower
+    // corner; Sphere: centre. Axisymmetric cylinders, plates and spheres must have origin x = 0.
+    std::array<double, 3> origin{0, 0, 0};
+    std::array<double, 3> size{0, 0, 0};  // rectangle/box
+    double radius = 0.0;                  // cylinder/plate/sphere
+    double length = 0.0;                  // cylinder/plate, along z
+    double spacing = 0.0;                 // lattice spacing dx (and dy, dz in 3D)
+    double spacing_z = 0.0;               // 2D: dz; 0 = equal to dx
+    std::string material;                 // a name in Scene::materials
+    std::array<double, 3> velocity{0, 0, 0};
+    // Initial Cauchy stress in NodeStore order (2D: xx, zz, xz, out-of-plane; 3D: xx, yy, zz, yz,
+    // xz, xy). Its deviator becomes s; its mean stress becomes an initial compression through the EOS.
+    std::array<double, 6> initial_stress{0, 0, 0, 0, 0, 0};
+    std::optional<ConnectivityMode> connectivity;  // overrides SolverOptions::connectivity
+    int lattice_neighbours = 0;                    // fixed lists: 4/8 (2D), 6/18/26 (3D); 0 = 8 or 26
+};
+
+enum class PlaneKind {
+    Rigid,     // a frictionless rigid wall; pushes only unless lift_off is false
+    Symmetry,  // a mirror plane; ghost pairs always act
+};
+
+// An axis-aligned plane with ghost (mirror) nodes (spec section 7). The axis of an
+// axisymmetric scene is a symmetry plane of its own and is not listed.
+struct PlaneSpec {
+    std::string name;
+    PlaneKind kind = PlaneKind::Rigid;
+    int axis = 1;           // normal direction: 0 = x, 1 = z in 2D; 0, 1, 2 = x, y, z in 3D
+    double position = 0.0;  // coordinate of the plane along `axis`
+    int side = +1;          // the bodies lie where the coordinate is above (+1) or below (-1) the plane
+    bool lift_off = true;   // rigid only: false = the paper's no-lift-off (nodes on it may not leave)
+};
+
+struct SolverOptions {
+    ConnectivityMode connectivity = ConnectivityMode::Variable;
+    double switch_plastic_strain = 0.1;  // Automatic: switch at this equivalent plastic strain
+    double influence_distance = 1.0;     // a, 0.8-1.5 (Eq. 2)
+    WeightKind weight = WeightKind::Gpa;
+    ViscosityKind viscosity = ViscosityKind::Nodal;
+    double viscosity_linear = 0.2;     // C_L (Eq. 36, 37)
+    double viscosity_quadratic = 4.0;  // C_Q
+    double bond_viscosity_eps0 = 0.01; // Eq. 38
+    SmoothingMode smoothing = SmoothingMode::Off;
+    double smoothing_coefficient = 0.1;  // C_cs (Eq. 67)
+    double cfl = 0.5;                    // C_cfl of the stable time step (spec section 11)
+    double max_time_step = std::numeric_limits<double>::infinity();  // s
+    double time_step_growth = 1.1;       // largest ratio of one step to the previous
+    bool failure = false;                // apply the materials' failure models (J-C damage, spall)
+    ScatterScheme scatter = ScatterScheme::Slabs;
+    std::size_t reorder_interval = 200;  // steps between locality reorderings (0 = never)
+};
+
+struct StopCriteria {
+    double end_time = 0.0;                 // s; 0 = no time limit
+    double kinetic_energy_fraction = 0.0;  // stop when KE < fraction * initial KE; 0 = off
+    std::size_t max_steps = 0;             // 0 = no limit
+};
+
+struct OutputOptions {
+    std::size_t snapshots = 20;      // ParaView snapshots over the run (first and last included); 0 = last only
+    double snapshot_interval = 0.0;  // s; > 0 overrides `snapshots`
+    std::size_t history_every = 10;  // steps between history rows (the last step is always written)
+};
+
+struct Scene {
+    std::string name;
+    std::string description;
+    GeometryKind geometry = GeometryKind::Axisymmetric;
+    std::vector<materials::Material> materials;
+    std::vector<BodySpec> bodies;
+    std::vector<PlaneSpec> planes;
+    SolverOptions solver;
+    StopCriteria stop;
+    OutputOptions output;
+    // Known answers the scene states, reported beside the run's own values, e.g.
+    // "final_length" and "footprint_diameter" (m) of a Taylor test. Keys are free-form words.
+    std::map<std::string, double> reference;
+    std::string reference_source;
+};
+
+// Throws InputError naming the body, plane or option when the scene is impossible (no bodies,
+// a body with a non-positive size or spacing, an unknown material name, a plane on a body's
+// wrong side, an option out of its range, a missing end condition, ...).
+void validate_scene(const Scene& scene);
+
+}  // namespace gpa

@@ -1,0 +1,1 @@
+// Run outputs (history CSV, summary JSON, run folder): see output.hpp.

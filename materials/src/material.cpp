@@ -1,0 +1,1 @@
+// Material models: implemented by the materials work (see material.hpp).
