@@ -1,0 +1,65 @@
+#pragma once
+// Helpers shared by the material model sources; not part of the public API.
+
+#include <Eigen/Core>
+
+#include "gpa/materials/material.hpp"
+
+namespace gpa::materials::detail {
+
+// Every equation of state here is linear in e at fixed rho: P = a(rho) + b(rho) e
+// (materials.md, "Equation of state"). The terms and their density derivatives give the
+// pressure, the exact energy solve of the point update and the isentropic bulk modulus.
+struct EosTerms {
+    double a = 0.0;        // P at e = 0, Pa
+    double b = 0.0;        // dP/de at fixed rho, kg/m^3
+    double da_drho = 0.0;  // m^2/s^2
+    double db_drho = 0.0;  // 1 (zero for every model here: Gamma rho = Gamma0 rho0)
+};
+
+EosTerms eos_terms(const EquationOfState& eos, double reference_density, double density);
+
+// The bulk modulus of the unstressed material: K (linear), K1 (polynomial), rho0 c0^2 (Mie-Grueneisen).
+double reference_bulk_modulus(const EquationOfState& eos, double reference_density);
+
+// K_s = rho dP/drho|_e + (P / rho) dP/de from the terms, floored at
+// kBulkModulusFloorFraction * reference bulk modulus (see eos.cpp).
+double isentropic_bulk_modulus(const EosTerms& t, double reference_bulk, double density, double energy);
+
+// The floor on K_s as a fraction of the reference bulk modulus (eos.cpp explains the value).
+inline constexpr double kBulkModulusFloorFraction = 0.01;
+
+// Mie-Grueneisen pole guard: compression is refused once (s - 1) mu reaches 1 - kPoleMargin,
+// i.e. mu >= 0.9 / (s - 1) (eos.cpp explains the value).
+inline constexpr double kPoleMargin = 0.1;
+
+// Symmetric tensors: Sym3 (xx, yy, zz, yz, xz, xy) <-> 3x3 matrix.
+Eigen::Matrix3d to_matrix(const Sym3& s);
+Sym3 to_sym3(const Eigen::Matrix3d& m);
+
+// sqrt(3/2 s:s), the von Mises equivalent of a deviator.
+double von_mises(const Eigen::Matrix3d& deviator);
+
+// Flow stress and its slope dY/d eps_p at fixed rate and temperature, for the plastic models.
+struct FlowStress {
+    double stress = 0.0;  // Y, Pa
+    double slope = 0.0;   // dY / d eps_p, Pa (infinite at eps_p = 0 when n < 1)
+};
+
+FlowStress johnson_cook_flow(const JohnsonCookStrength& jc, double plastic_strain, double strain_rate,
+                             double homologous_temperature);
+
+// Result of the radial return of a trial deviator (spec section 4).
+struct ReturnResult {
+    Eigen::Matrix3d deviator;              // on or inside the yield surface
+    double plastic_strain_increment = 0.0;  // d eps_p >= 0
+    double flow_stress = 0.0;              // Y at the end of the step (0 for an elastic material)
+    bool plastic = false;
+};
+
+// Radial return of the trial deviator to the flow stress of `strength` at plastic strain
+// eps_p, strain rate (1/s) and homologous temperature; shear modulus G (Pa).
+ReturnResult radial_return(const Strength& strength, const Eigen::Matrix3d& trial, double shear_modulus,
+                           double plastic_strain, double strain_rate, double homologous_temperature);
+
+}  // namespace gpa::materials::detail

@@ -1,0 +1,159 @@
+// Strength models and the radial return (materials.md, "Strength"; gpa-method.md section 4).
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <type_traits>
+#include <variant>
+
+#include "internal.hpp"
+
+namespace gpa::materials {
+namespace detail {
+
+// Sym3 (xx, yy, zz, yz, xz, xy) as a symmetric 3x3 matrix (header: Sym3).
+Eigen::Matrix3d to_matrix(const Sym3& s) {
+    Eigen::Matrix3d m;
+    m << s[0], s[5], s[4],  //
+        s[5], s[1], s[3],   //
+        s[4], s[3], s[2];
+    return m;
+}
+
+// Symmetric part of m as Sym3 (xx, yy, zz, yz, xz, xy) (header: Sym3).
+Sym3 to_sym3(const Eigen::Matrix3d& m) {
+    return {m(0, 0), m(1, 1), m(2, 2), 0.5 * (m(1, 2) + m(2, 1)), 0.5 * (m(0, 2) + m(2, 0)),
+            0.5 * (m(0, 1) + m(1, 0))};
+}
+
+// Von Mises equivalent stress sqrt(3/2 s:s) of a deviator s (materials.md, "Strength").
+double von_mises(const Eigen::Matrix3d& deviator) { return std::sqrt(1.5 * deviator.squaredNorm()); }
+
+// Johnson-Cook flow stress and hardening slope (materials.md, "Strength"):
+//   Y = (A + B eps_p^n)(1 + C ln(max(epsdot / epsdot0, 1)))(1 - T*^m),
+// with the edges guarded: eps_p^n = 0 at eps_p <= 0; the rate ratio floored at 1 so the rate term
+// never weakens the material; T* clamped to [0, 1]; Y = 0 at and above melt (T* >= 1).
+// dY/d eps_p = B n eps_p^(n - 1) (rate and thermal factors), infinite at eps_p = 0 when n < 1.
+FlowStress johnson_cook_flow(const JohnsonCookStrength& jc, double plastic_strain, double strain_rate,
+                             double homologous_temperature) {
+    const double t_star = std::clamp(homologous_temperature, 0.0, 1.0);
+    if (t_star >= 1.0) {
+        return {0.0, 0.0};
+    }
+    const double thermal = 1.0 - std::pow(t_star, jc.m);  // pow(0, m) = 0 for m > 0
+    const double rate = 1.0 + jc.c * std::log(std::max(strain_rate / jc.reference_strain_rate, 1.0));
+
+    double hardening = jc.a;
+    double slope = 0.0;
+    if (jc.b != 0.0 && jc.n > 0.0) {
+        if (plastic_strain > 0.0) {
+            const double eps_n = std::pow(plastic_strain, jc.n);
+            hardening += jc.b * eps_n;
+            slope = jc.b * jc.n * eps_n / plastic_strain;
+        } else {
+            slope = jc.n < 1.0 ? std::numeric_limits<double>::infinity() : (jc.n == 1.0 ? jc.b : 0.0);
+        }
+    } else if (jc.b != 0.0 && plastic_strain > 0.0) {
+        hardening += jc.b;  // n = 0: a step at eps_p = 0 (validate() only allows it with B = 0)
+    }
+    return {hardening * rate * thermal, slope * rate * thermal};
+}
+
+namespace {
+
+// Scale the trial deviator back to the flow stress: s = s* Y / sigma_eq* (radial return).
+ReturnResult project(const Eigen::Matrix3d& trial, double trial_equivalent, double flow_stress,
+                     double plastic_increment) {
+    ReturnResult r;
+    r.deviator = trial * (flow_stress / trial_equivalent);
+    r.plastic_strain_increment = plastic_increment;
+    r.flow_stress = flow_stress;
+    r.plastic = true;
+    return r;
+}
+
+// Johnson-Cook radial return with hardening: solve
+//   f(x) = sigma_eq* - 3 G x - Y(eps_p + x) = 0,   x = d eps_p,
+// by Newton's method safeguarded with bisection. f(0) > 0 (the trial is beyond yield) and f is
+// decreasing because Y does not fall with eps_p; at the perfectly plastic estimate
+// x_hi = (sigma_eq* - Y(eps_p)) / (3 G) f = Y(eps_p) - Y(eps_p + x_hi) <= 0, so [0, x_hi] brackets
+// the root. Stop when |f| <= 1e-13 sigma_eq* or the bracket has shrunk to round-off; the deviator
+// is then scaled to Y(eps_p + x) itself, so it lies on the yield surface to round-off, and the
+// consistency residual sigma_eq* - 3 G x - Y is within the tolerance.
+ReturnResult johnson_cook_return(const JohnsonCookStrength& jc, const Eigen::Matrix3d& trial, double trial_equivalent,
+                                 double shear_modulus, double plastic_strain, double strain_rate,
+                                 double t_star, double initial_flow_stress) {
+    const double three_g = 3.0 * shear_modulus;
+    double lo = 0.0;
+    double hi = (trial_equivalent - initial_flow_stress) / three_g;
+    double x = hi;
+    const double tolerance = 1e-13 * trial_equivalent;
+    FlowStress y = johnson_cook_flow(jc, plastic_strain + x, strain_rate, t_star);
+    for (int iteration = 0; iteration < 200; ++iteration) {
+        const double f = trial_equivalent - three_g * x - y.stress;
+        if (std::abs(f) <= tolerance) {
+            break;
+        }
+        if (f > 0.0) {
+            lo = x;
+        } else {
+            hi = x;
+        }
+        if (hi - lo <= 4.0 * std::numeric_limits<double>::epsilon() * hi) {
+            break;
+        }
+        const double newton = x + f / (three_g + y.slope);  // f' = -(3 G + dY/d eps_p)
+        x = (newton > lo && newton < hi) ? newton : 0.5 * (lo + hi);
+        y = johnson_cook_flow(jc, plastic_strain + x, strain_rate, t_star);
+    }
+    return project(trial, trial_equivalent, y.stress, x);
+}
+
+}  // namespace
+
+// Radial return (gpa-method.md section 4): if sigma_eq(s*) exceeds the flow stress, scale s* back
+// along itself onto the yield surface; the plastic strain increment satisfies
+// sigma_eq* - 3 G d eps_p = Y(eps_p + d eps_p). Y = 0 at and above melt for both plastic models
+// (materials.md). With G = 0 no elastic strain exists to turn plastic: the deviator is only
+// scaled back and d eps_p = 0.
+ReturnResult radial_return(const Strength& strength, const Eigen::Matrix3d& trial, double shear_modulus,
+                           double plastic_strain, double strain_rate, double homologous_temperature) {
+    ReturnResult elastic;
+    elastic.deviator = trial;
+    if (std::holds_alternative<ElasticStrength>(strength)) {
+        return elastic;
+    }
+    const double t_star = std::clamp(homologous_temperature, 0.0, 1.0);
+    const double trial_equivalent = von_mises(trial);
+
+    if (const auto* vm = std::get_if<VonMisesStrength>(&strength)) {
+        const double y = t_star >= 1.0 ? 0.0 : vm->yield_stress;
+        elastic.flow_stress = y;
+        if (!(trial_equivalent > y)) {
+            return elastic;
+        }
+        const double increment = shear_modulus > 0.0 ? (trial_equivalent - y) / (3.0 * shear_modulus) : 0.0;
+        return project(trial, trial_equivalent, y, increment);
+    }
+
+    const auto& jc = std::get<JohnsonCookStrength>(strength);
+    const double y0 = johnson_cook_flow(jc, plastic_strain, strain_rate, t_star).stress;
+    elastic.flow_stress = y0;
+    if (!(trial_equivalent > y0)) {
+        return elastic;
+    }
+    if (!(shear_modulus > 0.0)) {
+        return project(trial, trial_equivalent, y0, 0.0);
+    }
+    return johnson_cook_return(jc, trial, trial_equivalent, shear_modulus, plastic_strain, strain_rate, t_star, y0);
+}
+
+}  // namespace detail
+
+// Public Johnson-Cook flow stress (materials.md, "Strength"); see detail::johnson_cook_flow.
+double johnson_cook_flow_stress(const JohnsonCookStrength& jc, double plastic_strain, double strain_rate,
+                                double homologous_temperature) {
+    return detail::johnson_cook_flow(jc, plastic_strain, strain_rate, homologous_temperature).stress;
+}
+
+}  // namespace gpa::materials

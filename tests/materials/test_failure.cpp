@@ -1,0 +1,204 @@
+// Johnson-Cook damage and spall (materials.md, "Fracture"): the failure strain and its floor,
+// damage accumulation, failure at D >= 1 (no deviator, no tension afterwards), spall only when
+// failure is enabled.
+
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "material_fixtures.hpp"
+
+namespace gpa::materials {
+namespace {
+
+using test::Driver;
+using test::pure_shear;
+using test::von_mises;
+
+// Exact formulas evaluated in a handful of flops: agreement to a few ulp, 1e-12 relative.
+constexpr double kRoundOff = 1e-12;
+
+// materials.md, Johnson-Cook fracture constants.
+const JohnsonCookFailure kCopperFracture{0.54, 4.89, -3.03, 0.014, 1.12, 1.0, 0.01};
+const JohnsonCookFailure kIronFracture{-2.20, 5.43, -0.47, 0.016, 0.63, 1.0, 0.01};
+
+double eps_f_closed_form(const JohnsonCookFailure& f, double sigma_star, double rate, double t_star) {
+    return (f.d1 + f.d2 * std::exp(f.d3 * sigma_star)) * (1.0 + f.d4 * std::log(rate)) * (1.0 + f.d5 * t_star);
+}
+
+TEST(JohnsonCookFailureStrain, MatchesClosedForm) {
+    for (double sigma_star : {-0.5, 0.0, 1.0 / 3.0, 0.8}) {
+        for (double rate : {1.0, 1e3}) {
+            for (double t_star : {0.0, 0.4}) {
+                const double expected = eps_f_closed_form(kCopperFracture, sigma_star, rate, t_star);
+                EXPECT_NEAR(johnson_cook_failure_strain(kCopperFracture, sigma_star, rate, t_star), expected,
+                            kRoundOff * expected);
+            }
+        }
+    }
+}
+
+TEST(JohnsonCookFailureStrain, FloorAndGuards) {
+    // Armco iron: D1 + D2 exp(D3 sigma*) < 0 for sigma* > ln(5.43 / 2.2) / 0.47 = 1.9224; at 1.92 it lies in (0, 0.01).
+    const double raw = eps_f_closed_form(kIronFracture, 2.5, 1.0, 0.0);
+    ASSERT_LT(raw, 0.0);
+    EXPECT_EQ(johnson_cook_failure_strain(kIronFracture, 2.5, 1.0, 0.0), 0.01);
+    EXPECT_EQ(johnson_cook_failure_strain(kIronFracture, 10.0, 1e4, 0.5), 0.01);
+    // Below the floor but positive: floored too.
+    const double small = eps_f_closed_form(kIronFracture, 1.92, 1.0, 0.0);
+    ASSERT_GT(small, 0.0);
+    ASSERT_LT(small, 0.01);
+    EXPECT_EQ(johnson_cook_failure_strain(kIronFracture, 1.92, 1.0, 0.0), 0.01);
+    // Rate below the reference (and zero) behaves as the reference rate: no log of 0.
+    const double at_reference = johnson_cook_failure_strain(kCopperFracture, 0.3, 1.0, 0.2);
+    EXPECT_EQ(johnson_cook_failure_strain(kCopperFracture, 0.3, 1e-3, 0.2), at_reference);
+    EXPECT_EQ(johnson_cook_failure_strain(kCopperFracture, 0.3, 0.0, 0.2), at_reference);
+    // T* clamped to [0, 1].
+    EXPECT_EQ(johnson_cook_failure_strain(kCopperFracture, 0.3, 1.0, -1.0),
+              johnson_cook_failure_strain(kCopperFracture, 0.3, 1.0, 0.0));
+    EXPECT_EQ(johnson_cook_failure_strain(kCopperFracture, 0.3, 1.0, 3.0),
+              johnson_cook_failure_strain(kCopperFracture, 0.3, 1.0, 1.0));
+}
+
+// Copper strength with a linear EOS, no heating (T* = 0 throughout) and a fracture set with a
+// small failure strain: in pure shear P = 0, sigma* = 0, eps_f = (D1 + D2)(1 + D4 ln epsdot*).
+Material shear_failure_material() {
+    Material m = test::copper_linear();
+    m.specific_heat = 0.0;
+    m.failure.johnson_cook = JohnsonCookFailure{0.05, 0.05, -1.5, 0.01, 0.5, 1.0, 0.01};
+    return m;
+}
+
+TEST(Damage, AccumulatesPlasticStrainOverFailureStrainAndFailsAtOne) {
+    const Material m = shear_failure_material();
+    Driver p(m);
+    p.failure_enabled = true;
+    const double gamma_dot = 1e3, dt = 1e-7;
+    const double rate = gamma_dot / std::sqrt(3.0);
+    const double eps_f = 0.1 * (1.0 + 0.01 * std::log(rate));
+    int failure_step = -1;
+    for (int step = 0; step < 10000 && failure_step < 0; ++step) {
+        const double damage_before = p.state.damage;
+        const PointResult r = p.step(pure_shear(gamma_dot), dt);
+        EXPECT_EQ(p.state.pressure, 0.0);
+        // D = sum d eps_p / eps_f with eps_f constant on this path.
+        EXPECT_NEAR(p.state.damage, p.state.plastic_strain / eps_f, kRoundOff * std::max(p.state.damage, 1e-3));
+        if (r.failed_now) {
+            failure_step = step;
+            EXPECT_LT(damage_before, 1.0);
+            EXPECT_GE(p.state.damage, 1.0);
+            EXPECT_TRUE(p.state.failed);
+        } else {
+            EXPECT_FALSE(p.state.failed);
+        }
+    }
+    ASSERT_GT(failure_step, 0);
+    EXPECT_NEAR(p.state.plastic_strain, eps_f, 1e-4);  // within one step's d eps_p (5.8e-5)
+    // Failed: no deviator, shear modulus gone from the sound speed.
+    EXPECT_EQ(von_mises(p.state.deviatoric_stress), 0.0);
+
+    // Further shear: no deviator, no plastic strain, no plastic work; sound speed is bulk only.
+    const double eps_at_failure = p.state.plastic_strain;
+    const PointResult r = p.step(pure_shear(gamma_dot), dt);
+    EXPECT_FALSE(r.failed_now);
+    EXPECT_EQ(von_mises(p.state.deviatoric_stress), 0.0);
+    EXPECT_EQ(p.state.plastic_strain, eps_at_failure);
+    EXPECT_EQ(r.plastic_work, 0.0);
+    const double k_s = evaluate_eos(m.eos, m.density, p.density, p.state.specific_internal_energy).bulk_modulus;
+    EXPECT_NEAR(r.sound_speed, std::sqrt(k_s / p.density), kRoundOff * r.sound_speed);
+
+    // No tension: expanding gives P = 0, not K mu < 0; compression still carries pressure.
+    p.step_to(Eigen::Matrix3d::Zero(), dt, 0.98 * m.density);
+    EXPECT_EQ(p.state.pressure, 0.0);
+    const double k = std::get<LinearEos>(m.eos).bulk_modulus;
+    p.step_to(Eigen::Matrix3d::Zero(), dt, 1.01 * m.density);
+    EXPECT_NEAR(p.state.pressure, 0.01 * k, kRoundOff * k);
+    EXPECT_TRUE(p.state.failed);
+}
+
+TEST(Damage, NothingAccumulatesWhenFailureIsDisabled) {
+    Driver p(shear_failure_material());
+    p.failure_enabled = false;
+    for (int step = 0; step < 3000; ++step) {  // eps_p ~ 0.17 > eps_f ~ 0.106
+        EXPECT_FALSE(p.step(pure_shear(1e3), 1e-7).failed_now);
+    }
+    EXPECT_GT(p.state.plastic_strain, 0.15);
+    EXPECT_EQ(p.state.damage, 0.0);
+    EXPECT_FALSE(p.state.failed);
+    EXPECT_GT(von_mises(p.state.deviatoric_stress), 0.0);
+}
+
+TEST(Damage, UsesTriaxialityFromPressureAndVonMisesStress) {
+    // Hold the density at 0.99 rho0 (tension, P = -0.01 K) and shear one plastic step:
+    // sigma* = -P / sigma_vm with the end-of-step values.
+    Material m = shear_failure_material();
+    Driver p(m);
+    p.failure_enabled = true;
+    p.density = 0.99 * m.density;
+    p.state.pressure = std::get<LinearEos>(m.eos).bulk_modulus * -0.01;
+    const double gamma_dot = 1e4, dt = 1e-6;
+    p.step_to(pure_shear(gamma_dot), dt, p.density);
+    ASSERT_GT(p.state.plastic_strain, 0.0);
+    const double sigma_star = -p.state.pressure / von_mises(p.state.deviatoric_stress);
+    EXPECT_GT(sigma_star, 1.0);  // 1.4 GPa of tension over ~100 MPa of flow stress
+    const double eps_f = eps_f_closed_form(*m.failure.johnson_cook, sigma_star, gamma_dot / std::sqrt(3.0), 0.0);
+    EXPECT_NEAR(p.state.damage, p.state.plastic_strain / std::max(eps_f, 0.01), kRoundOff * p.state.damage);
+}
+
+TEST(Damage, TriaxialityIsZeroWhereVonMisesStressVanishes) {
+    // Molten copper (Y = 0, so sigma_vm = 0 after the return) in tension: sigma* is defined as 0, so
+    // eps_f = (D1 + D2)(1 + D4 ln epsdot*)(1 + D5 T*) with T* = 1, finite and positive.
+    Material m = shear_failure_material();
+    Driver p(m);
+    p.failure_enabled = true;
+    p.state.temperature = 2000.0;
+    p.density = 0.99 * m.density;
+    p.state.pressure = std::get<LinearEos>(m.eos).bulk_modulus * -0.01;
+    const double gamma_dot = 1e3, dt = 1e-7;
+    p.step_to(pure_shear(gamma_dot), dt, p.density);
+    const double rate = gamma_dot / std::sqrt(3.0);
+    const double eps_f = (0.05 + 0.05) * (1.0 + 0.01 * std::log(rate)) * (1.0 + 0.5);
+    ASSERT_GT(p.state.plastic_strain, 0.0);
+    EXPECT_EQ(von_mises(p.state.deviatoric_stress), 0.0);
+    EXPECT_NEAR(p.state.damage, p.state.plastic_strain / eps_f, kRoundOff * p.state.damage);
+}
+
+// Elastic copper-like point with a spall pressure of 1 GPa; P = K mu with K = 138.6 GPa.
+Material spall_material() {
+    Material m = test::copper_linear();
+    m.strength = ElasticStrength{};
+    m.failure.spall_pressure = 1e9;
+    return m;
+}
+
+TEST(Spall, TriggersBelowMinusSpallPressureOnlyWhenEnabled) {
+    const Material m = spall_material();
+    const double k = std::get<LinearEos>(m.eos).bulk_modulus;
+    const double mu_above = -0.9e9 / k, mu_below = -1.1e9 / k;
+    for (bool enabled : {false, true}) {
+        Driver p(m);
+        p.failure_enabled = enabled;
+        p.state.deviatoric_stress = {1e7, -1e7, 0.0, 0.0, 0.0, 2e6};
+        PointResult r = p.step_to(Eigen::Matrix3d::Zero(), 1e-8, m.density * (1.0 + mu_above));
+        EXPECT_FALSE(r.failed_now);
+        EXPECT_NEAR(p.state.pressure, -0.9e9, kRoundOff * k);
+        r = p.step_to(Eigen::Matrix3d::Zero(), 1e-8, m.density * (1.0 + mu_below));
+        if (enabled) {
+            EXPECT_TRUE(r.failed_now);
+            EXPECT_TRUE(p.state.failed);
+            EXPECT_EQ(p.state.pressure, 0.0);  // no tension once failed
+            EXPECT_EQ(von_mises(p.state.deviatoric_stress), 0.0);
+            EXPECT_NEAR(r.sound_speed,
+                        std::sqrt(evaluate_eos(m.eos, m.density, p.density, 0.0).bulk_modulus / p.density),
+                        kRoundOff * r.sound_speed);
+        } else {
+            EXPECT_FALSE(r.failed_now);
+            EXPECT_FALSE(p.state.failed);
+            EXPECT_NEAR(p.state.pressure, -1.1e9, kRoundOff * k);
+            EXPECT_GT(von_mises(p.state.deviatoric_stress), 0.0);
+        }
+    }
+}
+
+}  // namespace
+}  // namespace gpa::materials

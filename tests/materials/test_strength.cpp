@@ -1,0 +1,288 @@
+// Strength (materials.md, "Strength"; gpa-method.md section 4): the Johnson-Cook flow stress and
+// its guarded edges, the Jaumann rate, and the radial return (on the yield surface, traceless,
+// plastic increment consistent with the return, no plastic flow below yield).
+
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include <Eigen/Geometry>
+#include <gtest/gtest.h>
+
+#include "material_fixtures.hpp"
+
+namespace gpa::materials {
+namespace {
+
+using test::Driver;
+using test::pure_shear;
+using test::to_matrix;
+using test::von_mises;
+
+// Exact formulas evaluated in a handful of flops: agreement to a few ulp, 1e-12 relative.
+constexpr double kRoundOff = 1e-12;
+
+// The closed form of materials.md, with its edges written out: rate ratio floored at 1,
+// T* clamped to [0, 1], eps_p^n = 0 at eps_p = 0.
+double jc_closed_form(const JohnsonCookStrength& jc, double eps, double rate, double t_star) {
+    const double hardening = jc.a + (eps > 0.0 ? jc.b * std::pow(eps, jc.n) : 0.0);
+    const double rate_factor = 1.0 + jc.c * std::log(std::max(rate / jc.reference_strain_rate, 1.0));
+    const double t = std::min(std::max(t_star, 0.0), 1.0);
+    return hardening * rate_factor * (1.0 - std::pow(t, jc.m));
+}
+
+const JohnsonCookStrength kCopper{90e6, 292e6, 0.31, 0.025, 1.09, 1.0};
+
+TEST(JohnsonCookFlowStress, MatchesClosedFormInsideTheRange) {
+    for (double eps : {0.01, 0.1, 0.5, 2.0}) {
+        for (double rate : {1.0, 10.0, 1e3, 1e5}) {
+            for (double t_star : {0.0, 0.2, 0.7, 0.99}) {
+                const double expected = (90e6 + 292e6 * std::pow(eps, 0.31)) * (1.0 + 0.025 * std::log(rate)) *
+                                        (1.0 - std::pow(t_star, 1.09));
+                EXPECT_NEAR(johnson_cook_flow_stress(kCopper, eps, rate, t_star), expected, kRoundOff * expected)
+                    << eps << " " << rate << " " << t_star;
+            }
+        }
+    }
+}
+
+TEST(JohnsonCookFlowStress, GuardedEdges) {
+    const double y_static = jc_closed_form(kCopper, 0.2, 1.0, 0.3);
+    // Rate below epsdot0 (and zero): the rate term is floored at 1, never weakening.
+    EXPECT_DOUBLE_EQ(johnson_cook_flow_stress(kCopper, 0.2, 0.01, 0.3), y_static);
+    EXPECT_DOUBLE_EQ(johnson_cook_flow_stress(kCopper, 0.2, 0.0, 0.3), y_static);
+    EXPECT_GT(y_static, (90e6 + 292e6 * std::pow(0.2, 0.31)) * (1.0 + 0.025 * std::log(0.01)) *
+                            (1.0 - std::pow(0.3, 1.09)));
+    // T* below 0 (T below room) clamps to 0: no thermal softening, and no NaN from pow(negative, m).
+    const double y_cold = johnson_cook_flow_stress(kCopper, 0.2, 1e3, -0.4);
+    EXPECT_TRUE(std::isfinite(y_cold));
+    EXPECT_DOUBLE_EQ(y_cold, jc_closed_form(kCopper, 0.2, 1e3, 0.0));
+    // At and above melt: Y = 0.
+    EXPECT_EQ(johnson_cook_flow_stress(kCopper, 0.2, 1e3, 1.0), 0.0);
+    EXPECT_EQ(johnson_cook_flow_stress(kCopper, 0.2, 1e3, 1.7), 0.0);
+    // eps_p = 0: eps_p^n = 0, Y = A (rate factor)(thermal factor).
+    const double y0 = johnson_cook_flow_stress(kCopper, 0.0, 1e3, 0.25);
+    EXPECT_NEAR(y0, 90e6 * (1.0 + 0.025 * std::log(1e3)) * (1.0 - std::pow(0.25, 1.09)), kRoundOff * y0);
+    // A non-unit reference rate divides the rate.
+    JohnsonCookStrength slow = kCopper;
+    slow.reference_strain_rate = 1e-3;
+    EXPECT_NEAR(johnson_cook_flow_stress(slow, 0.2, 1.0, 0.0), jc_closed_form(kCopper, 0.2, 1e3, 0.0),
+                kRoundOff * y_static);
+}
+
+TEST(HomologousTemperature, ClampsAndHandlesNoMelt) {
+    Material m = test::copper();  // room 294 K, melt 1356 K
+    EXPECT_EQ(homologous_temperature(m, 200.0), 0.0);
+    EXPECT_EQ(homologous_temperature(m, 294.0), 0.0);
+    EXPECT_NEAR(homologous_temperature(m, 825.0), 0.5, kRoundOff);
+    EXPECT_EQ(homologous_temperature(m, 1356.0), 1.0);
+    EXPECT_EQ(homologous_temperature(m, 2000.0), 1.0);
+    // Through the temperature: below room behaves as room, above melt gives Y = 0.
+    const auto& jc = std::get<JohnsonCookStrength>(m.strength);
+    EXPECT_DOUBLE_EQ(johnson_cook_flow_stress(jc, 0.1, 1e3, homologous_temperature(m, 77.0)),
+                     jc_closed_form(jc, 0.1, 1e3, 0.0));
+    EXPECT_EQ(johnson_cook_flow_stress(jc, 0.1, 1e3, homologous_temperature(m, 1500.0)), 0.0);
+    m.melt_temperature = std::numeric_limits<double>::infinity();
+    EXPECT_EQ(homologous_temperature(m, 5000.0), 0.0);
+}
+
+// The trial deviator of spec section 4, written out independently of the library.
+Eigen::Matrix3d jaumann_trial(const Eigen::Matrix3d& s, const Eigen::Matrix3d& l, double g, double dt) {
+    const Eigen::Matrix3d d = 0.5 * (l + l.transpose());
+    const Eigen::Matrix3d w = 0.5 * (l - l.transpose());
+    const Eigen::Matrix3d d_dev = d - d.trace() / 3.0 * Eigen::Matrix3d::Identity();
+    return s + dt * (2.0 * g * d_dev + w * s - s * w);
+}
+
+double equivalent_rate(const Eigen::Matrix3d& l) {
+    const Eigen::Matrix3d d = 0.5 * (l + l.transpose());
+    const Eigen::Matrix3d d_dev = d - d.trace() / 3.0 * Eigen::Matrix3d::Identity();
+    return std::sqrt(2.0 / 3.0 * d_dev.squaredNorm());
+}
+
+// A random velocity gradient with spin and volume change, entries of size `scale` (1/s).
+Eigen::Matrix3d random_gradient(std::mt19937& rng, double scale) {
+    std::uniform_real_distribution<double> u(-scale, scale);
+    Eigen::Matrix3d l;
+    for (int i = 0; i < 9; ++i) {
+        l(i / 3, i % 3) = u(rng);
+    }
+    return l;
+}
+
+TEST(RadialReturn, VonMisesLandsOnTheYieldSurface) {
+    Driver p(test::von_mises_aluminium());
+    const double g = p.material.shear_modulus;
+    const double y = 300e6;
+    std::mt19937 rng(7);
+    for (int step = 0; step < 50; ++step) {
+        const Eigen::Matrix3d l = random_gradient(rng, 1e4);
+        const double dt = 1e-6;  // strain increments ~1e-2: far beyond the yield strain 6e-3
+        const Eigen::Matrix3d trial = jaumann_trial(to_matrix(p.state.deviatoric_stress), l, g, dt);
+        const double eps_before = p.state.plastic_strain;
+        p.step(l, dt);
+        const double sigma_trial = von_mises(trial);
+        const double d_eps = p.state.plastic_strain - eps_before;
+        if (sigma_trial > y) {
+            EXPECT_NEAR(von_mises(p.state.deviatoric_stress), y, 1e-12 * y);
+            EXPECT_NEAR(d_eps, (sigma_trial - y) / (3.0 * g), 1e-10 * sigma_trial / (3.0 * g));
+            // Radial: s = s* Y / sigma*.
+            EXPECT_LE((to_matrix(p.state.deviatoric_stress) - trial * (y / sigma_trial)).norm(), 1e-10 * y);
+        } else {
+            EXPECT_EQ(d_eps, 0.0);
+        }
+        EXPECT_NEAR(test::trace(p.state.deviatoric_stress), 0.0, 1e-14 * y);
+    }
+}
+
+struct JcCase {
+    const char* name;
+    JohnsonCookStrength jc;
+    double shear_modulus;
+};
+
+// The Johnson-Cook rows of materials.md, plus an n > 1 set (convex hardening).
+std::vector<JcCase> jc_cases() {
+    return {{"OFHC copper", {90e6, 292e6, 0.31, 0.025, 1.09, 1.0}, 46e9},
+            {"Armco iron", {175e6, 380e6, 0.32, 0.060, 0.55, 1.0}, 80e9},
+            {"4340 steel", {792e6, 510e6, 0.26, 0.014, 1.03, 1.0}, 77e9},
+            {"2024-T351", {265e6, 426e6, 0.34, 0.015, 1.00, 1.0}, 27.6e9},
+            {"convex n=1.5", {200e6, 900e6, 1.5, 0.02, 1.0, 1.0}, 40e9}};
+}
+
+TEST(RadialReturn, JohnsonCookWithHardeningLandsOnTheYieldSurface) {
+    for (const JcCase& c : jc_cases()) {
+        Material m = test::copper_linear();
+        m.shear_modulus = c.shear_modulus;
+        m.strength = c.jc;
+        m.specific_heat = 400.0;  // temperature rises, so T* varies from step to step
+        Driver p(m);
+        std::mt19937 rng(11);
+        int plastic_steps = 0;
+        for (int step = 0; step < 60; ++step) {
+            const Eigen::Matrix3d l = random_gradient(rng, 2e4);
+            const double dt = 1e-6;
+            const Eigen::Matrix3d trial = jaumann_trial(to_matrix(p.state.deviatoric_stress), l, m.shear_modulus, dt);
+            const double t_star = homologous_temperature(m, p.state.temperature);  // start-of-step T
+            const double eps_before = p.state.plastic_strain;
+            const PointResult r = p.step(l, dt);
+            const double rate = equivalent_rate(l);
+            EXPECT_NEAR(r.plastic_strain_rate, rate, kRoundOff * rate);
+            const double sigma_trial = von_mises(trial);
+            const double d_eps = p.state.plastic_strain - eps_before;
+            const double y_start = johnson_cook_flow_stress(c.jc, eps_before, rate, t_star);
+            if (sigma_trial > y_start * (1.0 + 1e-12)) {
+                ++plastic_steps;
+                const double y_end = johnson_cook_flow_stress(c.jc, p.state.plastic_strain, rate, t_star);
+                // On the yield surface at the end-of-step plastic strain (spec: ~1e-10 relative).
+                EXPECT_NEAR(von_mises(p.state.deviatoric_stress), y_end, 1e-10 * y_end) << c.name;
+                // Consistency of the increment with the return: sigma* - 3 G d eps_p = Y(eps_p + d eps_p).
+                EXPECT_NEAR(sigma_trial - 3.0 * m.shear_modulus * d_eps, y_end, 1e-10 * sigma_trial) << c.name;
+                EXPECT_GT(d_eps, 0.0);
+            } else {
+                EXPECT_EQ(d_eps, 0.0) << c.name;
+            }
+            EXPECT_NEAR(test::trace(p.state.deviatoric_stress), 0.0, 1e-14 * std::max(sigma_trial, 1.0));
+        }
+        EXPECT_GT(plastic_steps, 30) << c.name;  // the test exercised the return
+    }
+}
+
+TEST(RadialReturn, FirstYieldFromZeroPlasticStrain) {
+    // n < 1: dY/d eps_p is infinite at eps_p = 0, where the Newton iteration starts its bracket.
+    Material m = test::copper_linear();
+    Driver p(m);
+    const double gamma_dot = 1e4, dt = 1e-6;  // one step of shear strain 1e-2
+    const double rate = gamma_dot / std::sqrt(3.0);
+    const PointResult r = p.step(pure_shear(gamma_dot), dt);
+    EXPECT_NEAR(r.plastic_strain_rate, rate, kRoundOff * rate);
+    const double sigma_trial = std::sqrt(3.0) * m.shear_modulus * gamma_dot * dt;  // s_xy = G gamma
+    const double y = johnson_cook_flow_stress(kCopper, p.state.plastic_strain, rate, 0.0);
+    EXPECT_NEAR(von_mises(p.state.deviatoric_stress), y, 1e-10 * y);
+    EXPECT_NEAR(sigma_trial - 3.0 * m.shear_modulus * p.state.plastic_strain, y, 1e-10 * sigma_trial);
+    EXPECT_GT(p.state.plastic_strain, 0.0);
+}
+
+TEST(RadialReturn, ElasticStepBelowYieldHasNoPlasticFlow) {
+    Material m = test::copper_linear();
+    Driver p(m);
+    const Eigen::Matrix3d l = pure_shear(1e3);
+    const double dt = 1e-7;  // shear strain 1e-4 per step: s_xy = 4.6 MPa, sigma_vm = 8 MPa < A = 90 MPa
+    for (int step = 0; step < 5; ++step) {
+        const Eigen::Matrix3d expected = jaumann_trial(to_matrix(p.state.deviatoric_stress), l, m.shear_modulus, dt);
+        const double t_before = p.state.temperature;
+        const PointResult r = p.step(l, dt);
+        EXPECT_EQ(p.state.plastic_strain, 0.0);
+        EXPECT_EQ(r.plastic_work, 0.0);
+        EXPECT_EQ(p.state.temperature, t_before);
+        EXPECT_LE((to_matrix(p.state.deviatoric_stress) - expected).norm(), kRoundOff * expected.norm());
+    }
+    EXPECT_LT(von_mises(p.state.deviatoric_stress), 90e6);
+}
+
+TEST(RadialReturn, ElasticMaterialNeverReturns) {
+    Material m = test::von_mises_aluminium();
+    m.strength = ElasticStrength{};
+    Driver p(m);
+    const double gamma_dot = 1e4, dt = 1e-5;  // shear strain 0.1: sigma_vm ~ 4.5 GPa
+    p.step(pure_shear(gamma_dot), dt);
+    EXPECT_NEAR(p.state.deviatoric_stress[5], m.shear_modulus * gamma_dot * dt, kRoundOff * 2.6e9);
+    EXPECT_EQ(p.state.plastic_strain, 0.0);
+}
+
+TEST(RadialReturn, MoltenPointCarriesNoDeviatorAndNoShearStiffness) {
+    Material m = test::copper_linear();
+    Driver p(m);
+    p.state.temperature = 1400.0;  // above the 1356 K melt
+    const double gamma_dot = 1e3, dt = 1e-6;
+    const PointResult r = p.step(pure_shear(gamma_dot), dt);
+    EXPECT_EQ(von_mises(p.state.deviatoric_stress), 0.0);
+    // Y = 0: all the trial strain is plastic, d eps_p = sigma* / (3 G) = gamma / sqrt(3).
+    EXPECT_NEAR(p.state.plastic_strain, gamma_dot * dt / std::sqrt(3.0), kRoundOff);
+    const double k_s = evaluate_eos(m.eos, m.density, p.density, p.state.specific_internal_energy).bulk_modulus;
+    EXPECT_NEAR(r.sound_speed, std::sqrt(k_s / p.density), kRoundOff * r.sound_speed);
+}
+
+TEST(Jaumann, OneStepMatchesTheRateFormula) {
+    Material m = test::von_mises_aluminium();
+    m.strength = ElasticStrength{};
+    Driver p(m);
+    p.state.deviatoric_stress = {2e8, -1.5e8, -0.5e8, 3e7, -2e7, 4e7};
+    std::mt19937 rng(3);
+    const Eigen::Matrix3d l = random_gradient(rng, 1e3);
+    const double dt = 1e-7;
+    const Eigen::Matrix3d expected = jaumann_trial(to_matrix(p.state.deviatoric_stress), l, m.shear_modulus, dt);
+    p.step(l, dt);
+    EXPECT_LE((to_matrix(p.state.deviatoric_stress) - expected).norm(), kRoundOff * expected.norm());
+}
+
+TEST(Jaumann, PureSpinRotatesTheDeviator) {
+    // v = omega x r about z: L_xy = -w, L_yx = w, D = 0. The Jaumann rate integrates to
+    // s(t) = R s0 R^T with R the rotation by w t. Forward Euler on s_dot = Omega s - s Omega
+    // amplifies the mode of angular frequency k w (k <= 2) by |1 + i k w dt|^N - 1 ~ 2 theta dtheta
+    // for theta = w t = 0.5 rad, dtheta = theta / N: tolerance 4 theta dtheta |s0|.
+    Material m = test::von_mises_aluminium();
+    m.strength = ElasticStrength{};
+    Driver p(m);
+    const Sym3 s0 = {2e8, -1e8, -1e8, 0.0, 0.0, 0.5e8};
+    p.state.deviatoric_stress = s0;
+    const double w = 1e4, theta = 0.5;
+    const int n = 5000;
+    const double dt = theta / w / n;
+    Eigen::Matrix3d l = Eigen::Matrix3d::Zero();
+    l(0, 1) = -w;
+    l(1, 0) = w;
+    for (int i = 0; i < n; ++i) {
+        p.step(l, dt);
+    }
+    const Eigen::Matrix3d r = Eigen::AngleAxisd(theta, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    const Eigen::Matrix3d expected = r * to_matrix(s0) * r.transpose();
+    const double tolerance = 4.0 * theta * (theta / n) * to_matrix(s0).norm();
+    EXPECT_LE((to_matrix(p.state.deviatoric_stress) - expected).norm(), tolerance);
+    // A rotation by 0.5 rad moves the tensor far more than the tolerance: the check can fail.
+    EXPECT_GT((expected - to_matrix(s0)).norm(), 100.0 * tolerance);
+    EXPECT_EQ(p.density, m.density);
+}
+
+}  // namespace
+}  // namespace gpa::materials
