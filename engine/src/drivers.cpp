@@ -1,5 +1,6 @@
 #include "gpa/engine/drivers.hpp"
 
+#include <algorithm>
 #include <atomic>
 #include <cstdint>
 #include <limits>
@@ -78,9 +79,8 @@ template <class G, class W>
 }
 
 template <class G, class W>
-void gradient_impl(const CompressedRows& lists, const GradientFields<G::dim>& f) {
+void gradient_impl(const CompressedRows& lists, const GradientFields<G::dim>& f, std::size_t n) {
     constexpr int D = G::dim;
-    const std::size_t n = lists.rows();
     std::atomic<std::size_t> first_bad{no_node};
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 256), [&](const tbb::blocked_range<std::size_t>& range) {
         for (std::size_t i = range.begin(); i != range.end(); ++i) {
@@ -93,7 +93,8 @@ void gradient_impl(const CompressedRows& lists, const GradientFields<G::dim>& f)
                 accumulate_gradient(p, f.size_weight[j], (load<D>(f.velocity, j) - v_i).eval(), sums);
             }
             // Eq. 14-15, 51-53: alpha_b = 1 / sum_j R W l_b^2.
-            const Vec<D> alpha = sums.moment.cwiseInverse();
+            Vec<D> alpha = sums.moment.cwiseInverse();
+            if (f.alpha_limit > 0.0) alpha = alpha.cwiseMin(f.alpha_limit / f.size_weight[i]);
             for (int b = 0; b < D; ++b) ok &= sums.moment[b] > 0.0;
             const Mat<D> L = velocity_gradient(sums, alpha);
             ok &= L.allFinite();
@@ -107,6 +108,8 @@ void gradient_impl(const CompressedRows& lists, const GradientFields<G::dim>& f)
             }
             f.volumetric_strain_rate[i] = volumetric_strain_rate<G>(L, v_i[0], f.pairs.position[0][i]);
             f.smallest_h[i] = sums.smallest_h;
+            f.smallest_distance[i] = sums.smallest_distance;
+            if (f.stable_length) f.stable_length[i] = stable_length(sums, alpha);
         }
     });
     if (const std::size_t bad = first_bad.load(); bad != no_node) report_gradient_failure<G, W>(lists, f, bad);
@@ -178,8 +181,10 @@ void forces_impl(const CompressedRows& lists, const ScatterPlan& plan, const Bon
 }  // namespace
 
 template <class G>
-void compute_velocity_gradient(const CompressedRows& lists, WeightKind weight, const GradientFields<G::dim>& f) {
-    dispatch_weight(weight, [&](auto w) { gradient_impl<G, decltype(w)>(lists, f); });
+void compute_velocity_gradient(const CompressedRows& lists, WeightKind weight, const GradientFields<G::dim>& f,
+                               std::size_t centres) {
+    const std::size_t n = std::min(centres, lists.rows());
+    dispatch_weight(weight, [&](auto w) { gradient_impl<G, decltype(w)>(lists, f, n); });
 }
 
 template <class G>
@@ -189,26 +194,27 @@ void compute_forces(const CompressedRows& lists, const ScatterPlan& plan, Weight
         throw InputError(fmt::format("compute_forces: the scatter plan covers {} centres, the lists {}",
                                      plan.centres.size(), lists.rows()));
     }
+    const BondViscosityParameters none{};
     dispatch_weight(weight, [&](auto w) {
         using W = decltype(w);
         if (bond) {
             forces_impl<G, W, true>(lists, plan, *bond, f, node_count);
         } else {
-            forces_impl<G, W, false>(lists, plan, BondViscosityParameters{}, f, node_count);
+            forces_impl<G, W, false>(lists, plan, none, f, node_count);
         }
     });
 }
 
 template void compute_velocity_gradient<PlaneStrain>(const CompressedRows&, WeightKind,
-                                                const GradientFields<PlaneStrain::dim>&);
+                                                const GradientFields<PlaneStrain::dim>&, std::size_t);
 template void compute_forces<PlaneStrain>(const CompressedRows&, const ScatterPlan&, WeightKind,
                                      const BondViscosityParameters*, const ForceFields<PlaneStrain::dim>&, std::size_t);
 template void compute_velocity_gradient<Axisymmetric>(const CompressedRows&, WeightKind,
-                                                const GradientFields<Axisymmetric::dim>&);
+                                                const GradientFields<Axisymmetric::dim>&, std::size_t);
 template void compute_forces<Axisymmetric>(const CompressedRows&, const ScatterPlan&, WeightKind,
                                      const BondViscosityParameters*, const ForceFields<Axisymmetric::dim>&, std::size_t);
 template void compute_velocity_gradient<ThreeD>(const CompressedRows&, WeightKind,
-                                                const GradientFields<ThreeD::dim>&);
+                                                const GradientFields<ThreeD::dim>&, std::size_t);
 template void compute_forces<ThreeD>(const CompressedRows&, const ScatterPlan&, WeightKind,
                                      const BondViscosityParameters*, const ForceFields<ThreeD::dim>&, std::size_t);
 

@@ -48,6 +48,8 @@ GradientFields<D> gradient_fields(NodeStore& nodes, double influence_distance) {
     g.size_weight = nodes.size_weight.data();
     g.volumetric_strain_rate = nodes.volumetric_strain_rate.data();
     g.smallest_h = nodes.smallest_h.data();
+    g.smallest_distance = nodes.smallest_distance.data();
+    g.stable_length = nodes.stable_length.data();
     return g;
 }
 

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <optional>
 #include <unordered_map>
 #include <vector>
 
@@ -126,18 +127,58 @@ std::size_t fill_lattice(NodeStore& nodes, const LatticeBlock& block) {
     }
     update_size_weights(nodes, first_new, first_new + added);
 
-    // Fixed lists of the new nodes: their stencil neighbours that exist, in stencil order.
+    // Fixed lists of the new nodes: their stencil neighbours that exist, in stencil order; and
+    // where a stencil neighbour falls behind mirror planes, the ghost image of the cell that
+    // mirrors it (the lattice continues across the plane, spec section 7).
     const auto offsets = stencil_offsets(dim, block.lattice_neighbours);
     auto& rows = nodes.fixed_neighbours;
     rows.offsets.resize(first_new + 1);
     rows.indices.resize(rows.offsets.back());
+    auto& mirrors = nodes.fixed_mirrors;
+    mirrors.offsets.resize(first_new + 1);
+    mirrors.indices.resize(mirrors.offsets.back());
+    nodes.fixed_mirror_planes.resize(mirrors.offsets.back());
+    const auto cell_at = [&](const std::array<double, 3>& p) -> std::optional<NodeIndex> {
+        std::array<std::int64_t, 3> k{block.first[0], block.first[1], block.first[2]};
+        for (int c = 0; c < dim; ++c) {
+            const double f = (p[c] - block.origin[c]) / block.spacing[c] - 0.5;
+            const double r = std::round(f);
+            if (std::abs(f - r) > 1e-6) return std::nullopt;  // the plane is not on a cell face
+            k[c] = static_cast<std::int64_t>(r);
+        }
+        if (const auto it = index_of.find(k); it != index_of.end()) return it->second;
+        return std::nullopt;
+    };
     for (std::size_t k = 0; k < added; ++k) {
         for (const auto& o : offsets) {
             // 2D offsets are (dx, dz) in components 0 and 1.
             std::array<std::int64_t, 3> nb{cells[k][0] + o[0], cells[k][1] + o[1], cells[k][2] + o[2]};
-            if (const auto it = index_of.find(nb); it != index_of.end()) rows.indices.push_back(it->second);
+            if (const auto it = index_of.find(nb); it != index_of.end()) {
+                rows.indices.push_back(it->second);
+                continue;
+            }
+            // The planes this missing neighbour lies behind; mirror it across all of them.
+            std::array<double, 3> p = centres[k];
+            for (int c = 0; c < dim; ++c) p[c] += o[c] * block.spacing[c];
+            std::uint8_t mask = 0;
+            bool distinct_axes = true;
+            int axes_seen = 0;
+            for (const auto& plane : block.mirror_planes) {
+                if (plane.side * (p[plane.axis] - plane.position) < 0.0) {
+                    if (axes_seen & (1 << plane.axis)) distinct_axes = false;
+                    axes_seen |= 1 << plane.axis;
+                    mask |= static_cast<std::uint8_t>(1u << plane.bit);
+                    p[plane.axis] = 2.0 * plane.position - p[plane.axis];
+                }
+            }
+            if (mask == 0 || !distinct_axes) continue;
+            if (const auto source = cell_at(p)) {
+                mirrors.indices.push_back(*source);
+                nodes.fixed_mirror_planes.push_back(mask);
+            }
         }
         rows.offsets.push_back(rows.indices.size());
+        mirrors.offsets.push_back(mirrors.indices.size());
     }
     return first_new;
 }

@@ -101,13 +101,16 @@ bool needs_search(const NodeStore& nodes, std::size_t centres) {
 }
 
 void find_neighbours(const NodeStore& nodes, double a, std::size_t centres, CompressedRows& out,
-                     NeighbourScratch& scratch) {
+                     NeighbourScratch& scratch, const CompressedRows* extra_fixed) {
     check_influence_distance(a);
     const std::size_t n = nodes.size();
     if (centres > n) throw InputError(fmt::format("find_neighbours: {} centres of {} nodes", centres, n));
     if (nodes.fixed_neighbours.rows() < centres) {
         throw InputError(fmt::format("find_neighbours: fixed lists cover {} of {} centres",
                                      nodes.fixed_neighbours.rows(), centres));
+    }
+    if (extra_fixed && extra_fixed->rows() < centres) {
+        throw InputError(fmt::format("find_neighbours: extra fixed lists cover {} of {} centres", extra_fixed->rows(), centres));
     }
     const bool search = needs_search(nodes, centres);
     if (search) scratch.grid.build(nodes, n, largest_interaction_radius(nodes, a, n));
@@ -130,6 +133,10 @@ void find_neighbours(const NodeStore& nodes, double a, std::size_t centres, Comp
                 if (fixed) {
                     const auto row = nodes.fixed_neighbours.row(i);
                     indices.insert(indices.end(), row.begin(), row.end());
+                    if (extra_fixed) {
+                        const auto extra = extra_fixed->row(i);
+                        indices.insert(indices.end(), extra.begin(), extra.end());
+                    }
                 }
                 if (search) {
                     const auto home = grid.cell_of(nodes, i);
@@ -183,7 +190,8 @@ CompressedRows find_neighbours(const NodeStore& nodes, double a, std::size_t cen
     return out;
 }
 
-CompressedRows find_neighbours_brute_force(const NodeStore& nodes, double a, std::size_t centres) {
+CompressedRows find_neighbours_brute_force(const NodeStore& nodes, double a, std::size_t centres,
+                                           const CompressedRows* extra_fixed) {
     check_influence_distance(a);
     std::vector<std::vector<NodeIndex>> rows(centres);
     for (std::size_t i = 0; i < centres; ++i) {
@@ -191,6 +199,7 @@ CompressedRows find_neighbours_brute_force(const NodeStore& nodes, double a, std
         if (fixed) {
             const auto row = nodes.fixed_neighbours.row(i);
             rows[i].assign(row.begin(), row.end());
+            if (extra_fixed) rows[i].insert(rows[i].end(), extra_fixed->row(i).begin(), extra_fixed->row(i).end());
         }
         for (std::size_t j = 0; j < nodes.size(); ++j) {
             if (j == i || (fixed && nodes.body[j] == nodes.body[i])) continue;

@@ -50,6 +50,12 @@ void NodeStore::for_each_field(F&& f) {
     f(temperature);
     f(plastic_strain);
     f(damage);
+    f(plastic_work);
+    f(viscous_work);
+    f(failed);
+    f(plane_contact);
+    f(smallest_distance);
+    f(stable_length);
     f(body);
     f(material);
     f(connectivity);
@@ -57,28 +63,58 @@ void NodeStore::for_each_field(F&& f) {
     f(smallest_h);
 }
 
+namespace {
+
+// Grows rows with empty lists, or drops the rows of removed nodes and every entry that names a
+// removed node (keeping `tags`, one per entry, aligned).
+void resize_rows(CompressedRows& rows, std::vector<std::uint8_t>* tags, std::size_t count) {
+    const std::size_t old_rows = rows.rows();
+    if (old_rows <= count) {
+        rows.offsets.resize(count + 1, rows.offsets.back());
+        return;
+    }
+    CompressedRows kept;
+    std::vector<std::uint8_t> kept_tags;
+    kept.offsets.reserve(count + 1);
+    for (std::size_t i = 0; i < count; ++i) {
+        for (std::size_t k = rows.offsets[i]; k < rows.offsets[i + 1]; ++k) {
+            if (rows.indices[k] >= count) continue;
+            kept.indices.push_back(rows.indices[k]);
+            if (tags) kept_tags.push_back((*tags)[k]);
+        }
+        kept.offsets.push_back(kept.indices.size());
+    }
+    rows = std::move(kept);
+    if (tags) *tags = std::move(kept_tags);
+}
+
+// Rewrites rows in a new node order (new node k is old node new_to_old[k]).
+void permute_rows(CompressedRows& rows, std::vector<std::uint8_t>* tags, std::span<const NodeIndex> new_to_old,
+                  const std::vector<NodeIndex>& old_to_new) {
+    CompressedRows out;
+    std::vector<std::uint8_t> out_tags;
+    out.offsets.reserve(new_to_old.size() + 1);
+    out.indices.reserve(rows.entries());
+    for (NodeIndex old : new_to_old) {
+        for (std::size_t k = rows.offsets[old]; k < rows.offsets[old + 1]; ++k) {
+            out.indices.push_back(old_to_new[rows.indices[k]]);
+            if (tags) out_tags.push_back((*tags)[k]);
+        }
+        out.offsets.push_back(out.indices.size());
+    }
+    rows = std::move(out);
+    if (tags) *tags = std::move(out_tags);
+}
+
+}  // namespace
+
 void NodeStore::resize(std::size_t count) {
     if (count > std::size_t{0xFFFFFFFFu}) {
         throw InputError(fmt::format("node count {} exceeds the limit of 2^32 - 1 nodes", count));
     }
     for_each_field([count](auto& field) { field.resize(count); });
-    const std::size_t rows = fixed_neighbours.rows();
-    if (rows < count) {
-        fixed_neighbours.offsets.resize(count + 1, fixed_neighbours.offsets.back());
-    } else if (rows > count) {
-        fixed_neighbours.offsets.resize(count + 1);
-        fixed_neighbours.indices.resize(fixed_neighbours.offsets.back());
-        // Lists of the remaining nodes may still name removed nodes; drop those entries.
-        CompressedRows kept;
-        kept.offsets.reserve(count + 1);
-        for (std::size_t i = 0; i < count; ++i) {
-            for (NodeIndex j : fixed_neighbours.row(i)) {
-                if (j < count) kept.indices.push_back(j);
-            }
-            kept.offsets.push_back(kept.indices.size());
-        }
-        fixed_neighbours = std::move(kept);
-    }
+    resize_rows(fixed_neighbours, nullptr, count);
+    resize_rows(fixed_mirrors, &fixed_mirror_planes, count);
 }
 
 void NodeStore::permute(std::span<const NodeIndex> new_to_old) {
@@ -100,14 +136,8 @@ void NodeStore::permute(std::span<const NodeIndex> new_to_old) {
         auto copy = field;
         for (std::size_t k = 0; k < n; ++k) field[k] = copy[new_to_old[k]];
     });
-    CompressedRows remapped;
-    remapped.offsets.reserve(n + 1);
-    remapped.indices.reserve(fixed_neighbours.entries());
-    for (std::size_t k = 0; k < n; ++k) {
-        for (NodeIndex j : fixed_neighbours.row(new_to_old[k])) remapped.indices.push_back(old_to_new[j]);
-        remapped.offsets.push_back(remapped.indices.size());
-    }
-    fixed_neighbours = std::move(remapped);
+    permute_rows(fixed_neighbours, nullptr, new_to_old, old_to_new);
+    permute_rows(fixed_mirrors, &fixed_mirror_planes, new_to_old, old_to_new);
 }
 
 namespace {

@@ -1,1 +1,201 @@
-// Run outputs (history CSV, summary JSON, run folder): see output.hpp.
+#include "gpa/io/output.hpp"
+
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <system_error>
+
+#include <fmt/format.h>
+
+namespace gpa::io {
+
+namespace fs = std::filesystem;
+
+RunFolder::RunFolder(fs::path folder, bool overwrite) : final_(std::move(folder)), overwrite_(overwrite) {
+    if (final_.empty()) throw OutputError("the output folder name is empty");
+    if (final_.filename().empty()) final_ = final_.parent_path();  // "out/" -> "out"
+    partial_ = final_;
+    partial_ += ".partial";
+    std::error_code ec;
+    if (fs::exists(final_, ec)) {
+        if (!fs::is_directory(final_, ec)) {
+            throw OutputError(fmt::format("output '{}' exists and is not a folder", final_.string()));
+        }
+        if (!fs::is_empty(final_, ec) && !overwrite_) {
+            throw OutputError(fmt::format("output folder '{}' exists and is not empty; choose another with -o "
+                                          "or pass --overwrite to replace it when the run ends",
+                                          final_.string()));
+        }
+    }
+    fs::remove_all(partial_, ec);
+    if (ec) throw OutputError(fmt::format("cannot clear '{}': {}", partial_.string(), ec.message()));
+    fs::create_directories(partial_, ec);
+    if (ec) throw OutputError(fmt::format("cannot create '{}': {}", partial_.string(), ec.message()));
+}
+
+void RunFolder::commit() {
+    std::error_code ec;
+    if (fs::exists(final_, ec)) {
+        if (!overwrite_ && !fs::is_empty(final_, ec)) {
+            throw OutputError(fmt::format("output folder '{}' appeared during the run; results stay in '{}'",
+                                          final_.string(), partial_.string()));
+        }
+        fs::remove_all(final_, ec);
+        if (ec) throw OutputError(fmt::format("cannot replace '{}': {}", final_.string(), ec.message()));
+    }
+    fs::rename(partial_, final_, ec);
+    if (ec) throw OutputError(fmt::format("cannot rename '{}' to '{}': {}", partial_.string(), final_.string(), ec.message()));
+}
+
+HistoryWriter::HistoryWriter(const fs::path& file, const Totals& first, int dim)
+    : path_(file), dim_(dim), planes_(first.planes.size()) {
+    file_ = std::fopen(file.string().c_str(), "w");
+    if (!file_) throw OutputError(fmt::format("cannot write '{}': {}", file.string(), std::strerror(errno)));
+    std::string header =
+        "time_s,dt_s,step,kinetic_energy_J,internal_energy_J,plastic_work_J,viscous_work_J,boundary_work_J,"
+        "total_energy_error";
+    header += dim == 3 ? ",momentum_x_kg_m_s,momentum_y_kg_m_s,momentum_z_kg_m_s" : ",momentum_x_kg_m_s,momentum_z_kg_m_s";
+    header += ",length_m,footprint_diameter_m";
+    for (const auto& p : first.planes) header += fmt::format(",{0}_reaction_N,{0}_impulse_N_s", p.name.empty() ? "plane" : p.name);
+    header += ",real_nodes,ghost_nodes,variable_nodes,failed_nodes,neighbour_pairs\n";
+    std::fputs(header.c_str(), file_);
+}
+
+HistoryWriter::~HistoryWriter() {
+    if (file_) std::fclose(file_);
+}
+
+void HistoryWriter::write(const Totals& t) {
+    std::string row = fmt::format("{:.9e},{:.6e},{},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.6e}", t.time, t.time_step, t.step,
+                                  t.kinetic_energy, t.internal_energy, t.plastic_work, t.viscous_work, t.boundary_work,
+                                  t.energy_error);
+    for (int c = 0; c < dim_; ++c) row += fmt::format(",{:.9e}", t.momentum[c]);
+    row += fmt::format(",{:.9e},{:.9e}", t.length, t.footprint_diameter);
+    for (std::size_t p = 0; p < planes_; ++p) {
+        const PlaneReport r = p < t.planes.size() ? t.planes[p] : PlaneReport{};
+        row += fmt::format(",{:.9e},{:.9e}", r.reaction, r.impulse);
+    }
+    row += fmt::format(",{},{},{},{},{}\n", t.real_nodes, t.ghost_nodes, t.variable_nodes, t.failed_nodes, t.pairs);
+    if (std::fputs(row.c_str(), file_) < 0 || std::fflush(file_) != 0) {
+        throw OutputError(fmt::format("writing '{}' failed: {}", path_.string(), std::strerror(errno)));
+    }
+}
+
+SnapshotSeries::SnapshotSeries(fs::path folder, std::string stem) : folder_(std::move(folder)), stem_(std::move(stem)) {}
+
+std::string SnapshotSeries::write(const NodeStore& nodes, std::size_t count, double time) {
+    const std::string name = fmt::format("{}_{:05d}.vtp", stem_, entries_.size());
+    write_vtp(folder_ / name, nodes, count);
+    entries_.push_back({time, name});
+    write_pvd(folder_ / (stem_ + ".pvd"), entries_);
+    return name;
+}
+
+namespace {
+
+std::string json_string(const std::string& s) {
+    std::string out = "\"";
+    for (unsigned char c : s) {
+        switch (c) {
+            case '"': out += "\\\""; break;
+            case '\\': out += "\\\\"; break;
+            case '\n': out += "\\n"; break;
+            case '\t': out += "\\t"; break;
+            case '\r': out += "\\r"; break;
+            default:
+                if (c < 0x20) {
+                    out += fmt::format("\\u{:04x}", c);
+                } else {
+                    out += static_cast<char>(c);
+                }
+        }
+    }
+    return out + "\"";
+}
+
+std::string json_number(double v) { return std::isfinite(v) ? fmt::format("{:.10g}", v) : "null"; }
+
+}  // namespace
+
+std::vector<ReferenceComparison> compare_with_reference(const Simulation& sim) {
+    std::vector<ReferenceComparison> out;
+    const auto& t = sim.totals();
+    const std::map<std::string, double> computed{
+        {"final_length", t.length}, {"footprint_diameter", t.footprint_diameter}, {"plastic_work", t.plastic_work}};
+    for (const auto& [key, value] : sim.scene().reference) {
+        const auto it = computed.find(key);
+        if (it == computed.end()) continue;
+        out.push_back({key, value, it->second, value != 0.0 ? (it->second - value) / value : 0.0});
+    }
+    return out;
+}
+
+void write_summary(const fs::path& file, const Simulation& sim, const RunSummary& run) {
+    const auto& t = sim.totals();
+    const auto& scene = sim.scene();
+    std::string j = "{\n";
+    const auto field = [&](const std::string& key, const std::string& value, bool last = false) {
+        j += fmt::format("  {}: {}{}\n", json_string(key), value, last ? "" : ",");
+    };
+    field("scene", json_string(scene.name));
+    field("scene_file", json_string(run.scene_file));
+    field("geometry", json_string(std::string(name_of(scene.geometry))));
+    field("status", json_string(run.status));
+    field("message", json_string(run.message));
+    field("time_s", json_number(t.time));
+    field("steps", std::to_string(t.step));
+    field("real_nodes", std::to_string(t.real_nodes));
+    field("ghost_nodes", std::to_string(t.ghost_nodes));
+    field("variable_nodes", std::to_string(t.variable_nodes));
+    field("failed_nodes", std::to_string(t.failed_nodes));
+    field("threads", std::to_string(sim.threads()));
+    field("final", fmt::format("{{\"length_m\": {}, \"footprint_diameter_m\": {}, \"plastic_work_J\": {}}}",
+                               json_number(t.length), json_number(t.footprint_diameter), json_number(t.plastic_work)));
+    field("energy", fmt::format("{{\"initial_J\": {}, \"kinetic_J\": {}, \"internal_J\": {}, \"plastic_work_J\": {}, "
+                                "\"viscous_work_J\": {}, \"boundary_work_J\": {}, \"relative_error\": {}}}",
+                                json_number(t.initial_energy), json_number(t.kinetic_energy), json_number(t.internal_energy),
+                                json_number(t.plastic_work), json_number(t.viscous_work), json_number(t.boundary_work),
+                                json_number(t.energy_error)));
+    std::string planes = "[";
+    for (std::size_t p = 0; p < t.planes.size(); ++p) {
+        planes += fmt::format("{}{{\"name\": {}, \"reaction_N\": {}, \"impulse_N_s\": {}}}", p ? ", " : "",
+                              json_string(t.planes[p].name), json_number(t.planes[p].reaction), json_number(t.planes[p].impulse));
+    }
+    field("planes", planes + "]");
+    std::string refs = "[";
+    const auto comparisons = compare_with_reference(sim);
+    for (std::size_t k = 0; k < comparisons.size(); ++k) {
+        const auto& c = comparisons[k];
+        refs += fmt::format("{}{{\"key\": {}, \"reference\": {}, \"computed\": {}, \"relative_error\": {}}}", k ? ", " : "",
+                            json_string(c.key), json_number(c.reference), json_number(c.computed), json_number(c.relative_error));
+    }
+    field("reference", refs + "]");
+    field("reference_source", json_string(scene.reference_source));
+    std::string phases = "{";
+    double stepping = 0.0;
+    const auto times = sim.phase_times();
+    for (std::size_t k = 0; k < times.size(); ++k) {
+        phases += fmt::format("{}{}: {}", k ? ", " : "", json_string(times[k].name), json_number(times[k].seconds));
+        stepping += times[k].seconds;
+    }
+    field("phase_seconds", phases + "}");
+    field("step_seconds", json_number(stepping));
+    field("output_seconds", json_number(run.output_seconds));
+    field("wall_seconds", json_number(run.wall_seconds));
+    field("node_steps_per_second", json_number(stepping > 0.0 ? sim.node_steps() / stepping : 0.0));
+    field("snapshots", std::to_string(run.snapshots), true);
+    j += "}\n";
+    auto tmp = file;
+    tmp += ".tmp";
+    {
+        std::ofstream out(tmp);
+        out << j;
+        if (!out) throw OutputError(fmt::format("cannot write '{}'", tmp.string()));
+    }
+    std::error_code ec;
+    fs::rename(tmp, file, ec);
+    if (ec) throw OutputError(fmt::format("cannot rename '{}': {}", tmp.string(), ec.message()));
+}
+
+}  // namespace gpa::io

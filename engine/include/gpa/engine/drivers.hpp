@@ -18,9 +18,11 @@ namespace gpa {
 // writes only its own values.
 // Throws InputError naming the node when a neighbourhood gives no geometry factor along some
 // axis (an empty or flat neighbourhood) and NumericalError when two nodes coincide.
+// centres: how many leading rows to process (the real nodes when ghost rows follow); the
+// default processes every row.
 template <class G>
 void compute_velocity_gradient(const CompressedRows& lists, WeightKind weight,
-                               const GradientFields<G::dim>& f);
+                               const GradientFields<G::dim>& f, std::size_t centres = static_cast<std::size_t>(-1));
 
 struct BondViscosityParameters {
     double linear = 0.2;     // C_L

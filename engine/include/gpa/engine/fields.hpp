@@ -56,6 +56,9 @@ struct GradientFields {
     std::array<double*, D * D> velocity_gradient{};  // L_ab at [a * D + b]
     double* volumetric_strain_rate = nullptr;
     double* smallest_h = nullptr;
+    double* smallest_distance = nullptr;
+    double* stable_length = nullptr;  // optional (kernels.hpp: stable_length)
+    double alpha_limit = 0.0;         // > 0: alpha_b <= alpha_limit / W_i
 };
 
 template <int D>

@@ -33,6 +33,8 @@ struct GradientSums {
     Vec<D> moment = Vec<D>::Zero();     // sum_j R W l_b^2, the inverse of alpha_b (Eq. 14, 15, 51-53)
     Mat<D> difference = Mat<D>::Zero(); // sum_j R W (v_a(j) - v_a(i)) l_b / r
     double smallest_h = INFINITY;
+    double smallest_distance = INFINITY;
+    Vec<D> stiffness = Vec<D>::Zero();  // sum_j (R W l_b / r)^2, for the stable time step
 };
 
 // Eq. 7-8, 10-11, 14-15, 42-53: one neighbour's contribution to the geometry factors and to
@@ -44,6 +46,19 @@ inline void accumulate_gradient(const PairGeometry<D>& p, double size_weight_j, 
     sums.moment += rw * p.l.cwiseProduct(p.l);
     sums.difference.noalias() += (rw / p.r) * dv * p.l.transpose();
     sums.smallest_h = std::fmin(sums.smallest_h, p.h);
+    sums.smallest_distance = std::fmin(sums.smallest_distance, p.r);
+    const Vec<D> g = (rw / p.r) * p.l;
+    sums.stiffness += g.cwiseProduct(g);
+}
+
+// The length that sets node i's stable time step (spec section 11, made to see degenerate
+// neighbourhoods): a velocity difference to a neighbour changes the node's strain rate by
+// alpha_b R W l_b / r, so its highest frequency is about c sqrt(sum_b alpha_b^2 sum_j (R W l_b / r)^2).
+// This returns c / omega; on a regular 2D lattice with a = 1 it is 1.46 times the spacing, and it
+// shrinks where neighbours crowd together or alpha grows.
+template <int D>
+inline double stable_length(const GradientSums<D>& sums, const Vec<D>& alpha) {
+    return 1.0 / std::sqrt(alpha.cwiseProduct(alpha).dot(sums.stiffness));
 }
 
 // Geometry factors alpha_b = 1 / sum_j R W l_b^2 and L_ab = alpha_b * difference_ab.

@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <vector>
 
 #include "gpa/engine/node_store.hpp"
 
@@ -15,6 +16,15 @@ namespace gpa {
 // Which lattice neighbours a fixed-connectivity node keeps.
 //   2D: 4 (along the axes) or 8 (with diagonals); 3D: 6 (faces), 18 (+ edges) or 26 (+ corners).
 int check_lattice_stencil(int dim, int neighbours);  // returns neighbours, or throws InputError
+
+// A plane across which the lattice continues by mirror images (a symmetry plane, the axis of an
+// axisymmetric body, a rigid plane with ghosts): bit `bit` of a mirror mask.
+struct MirrorPlane {
+    int axis = 1;
+    double position = 0.0;
+    int side = +1;  // the body lies where the coordinate is above (+1) or below (-1) the plane
+    int bit = 0;
+};
 
 struct LatticeBlock {
     // Lattice cell k (integer, per axis) has its node at origin + (k + 1/2) * spacing.
@@ -30,6 +40,9 @@ struct LatticeBlock {
     int lattice_neighbours = 8;                  // stencil of the fixed lists (see above)
     // Keeps the cells whose centre it accepts (x, z) or (x, y, z); empty: keep all.
     std::function<bool(const std::array<double, 3>&)> inside;
+    // Planes with ghosts: a stencil neighbour that falls behind them and whose mirror image is a
+    // cell of this block becomes a mirrored lattice neighbour (NodeStore::fixed_mirrors).
+    std::vector<MirrorPlane> mirror_planes;
 };
 
 // Appends the block's nodes to `nodes`, with mass, volume, size weight, diameter (d0 = sqrt(dx dz)

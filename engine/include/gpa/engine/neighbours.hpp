@@ -45,15 +45,18 @@ struct NeighbourScratch {
 
 // The neighbour lists of centres [0, centres), drawn from all nodes [0, nodes.size()):
 //   a variable centre: every j != i with r_ij < 2 h_ij;
-//   a fixed centre: its lattice neighbours, then every node of another body with r_ij < 2 h_ij.
+//   a fixed centre: its lattice neighbours, then its rows of `extra_fixed` (if given: the ghost
+//   images of lattice neighbours across planes), then every node of another body with
+//   r_ij < 2 h_ij.
 // Deterministic and independent of the thread count. Validates a (0.8-1.5).
 void find_neighbours(const NodeStore& nodes, double influence_distance, std::size_t centres,
-                     CompressedRows& out, NeighbourScratch& scratch);
+                     CompressedRows& out, NeighbourScratch& scratch,
+                     const CompressedRows* extra_fixed = nullptr);
 CompressedRows find_neighbours(const NodeStore& nodes, double influence_distance, std::size_t centres);
 
 // The same lists from an all-pairs loop: the check for find_neighbours. O(n^2).
 CompressedRows find_neighbours_brute_force(const NodeStore& nodes, double influence_distance,
-                                           std::size_t centres);
+                                           std::size_t centres, const CompressedRows* extra_fixed = nullptr);
 
 // A permutation (new_to_old, for NodeStore::permute) of nodes [first, last) that sorts them by
 // cell of a grid of the given edge, the longest axis varying slowest (so that slabs across it

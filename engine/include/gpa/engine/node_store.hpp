@@ -53,6 +53,10 @@ public:
     std::vector<double> temperature;               // K
     std::vector<double> plastic_strain;            // equivalent plastic strain
     std::vector<double> damage;                    // Johnson-Cook damage D
+    std::vector<double> plastic_work;              // accumulated specific plastic work, J/kg
+    std::vector<double> viscous_work;              // accumulated specific artificial-viscous work, J/kg
+    std::vector<std::uint8_t> failed;              // 1 once the node has failed (no deviator, no tension)
+    std::vector<std::uint8_t> plane_contact;       // bit p: in contact with lift-off plane p (ghosts.hpp)
     std::vector<std::int32_t> body;
     std::vector<std::int32_t> material;
     std::vector<Connectivity> connectivity;
@@ -62,10 +66,17 @@ public:
     std::array<std::vector<double>, 9> velocity_gradient;  // L_ab at [a * dim + b]
     std::vector<double> volumetric_strain_rate;            // eps_v_dot (Eq. 12), with hoop term
     std::vector<double> smallest_h;                        // min_j h_ij
+    std::vector<double> smallest_distance;                 // min_j r_ij
+    std::vector<double> stable_length;                     // c / omega of the node (kernels.hpp)
     std::array<std::vector<double>, 3> force;              // N (a ring's force in axisymmetric)
 
     // Lattice neighbours of each node for fixed connectivity (spec section 2).
     CompressedRows fixed_neighbours;
+    // Lattice neighbours that lie across a symmetry or rigid plane: the ghost image of node
+    // fixed_mirrors.indices[k] across the planes in bit mask fixed_mirror_planes[k] (spec section 7:
+    // "a fixed-connectivity node next to a plane has its ghost images in its neighbour list").
+    CompressedRows fixed_mirrors;
+    std::vector<std::uint8_t> fixed_mirror_planes;
 
 private:
     template <class F>

@@ -90,7 +90,12 @@ struct SolverOptions {
     double bond_viscosity_eps0 = 0.01; // Eq. 38
     SmoothingMode smoothing = SmoothingMode::Off;
     double smoothing_coefficient = 0.1;  // C_cs (Eq. 67)
-    double cfl = 0.5;                    // C_cfl of the stable time step (spec section 11)
+    double cfl = 0.3;                    // C_cfl of the stable time step (spec section 11)
+    // Upper bound on the geometry factors, alpha_b <= alpha_limit / W_i (0 = none, the paper's
+    // method). A node whose neighbours along one axis have all drifted to the edge of its radius
+    // of influence gets an unbounded alpha and explodes; on a regular lattice alpha W is 0.63 in
+    // the interior, 1.26 at a flat surface and 1.55 at a corner, so the default 3 leaves those alone.
+    double alpha_limit = 3.0;
     double max_time_step = std::numeric_limits<double>::infinity();  // s
     double time_step_growth = 1.1;       // largest ratio of one step to the previous
     bool failure = false;                // apply the materials' failure models (J-C damage, spall)

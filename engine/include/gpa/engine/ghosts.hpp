@@ -1,0 +1,109 @@
+#pragma once
+// Ghost (mirror-image) nodes of symmetry and rigid planes (spec section 7). Ghosts are stored
+// after the real nodes of a NodeStore and rebuilt every step: a ghost is an exact mirror of its
+// source node across one plane or, at corners, across several planes with distinct normals. It
+// copies volume, size weight, diameter, alpha, connectivity mode, body and material and carries
+// the mirrored position, velocity and stress. Ghosts act on real nodes as centres and as
+// neighbours; they are not integrated, and the forces on them are the planes' reactions.
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "gpa/engine/compressed_rows.hpp"
+#include "gpa/engine/lattice.hpp"
+#include "gpa/engine/node_store.hpp"
+
+namespace gpa {
+
+struct GhostPlane {
+    std::string name;
+    int axis = 1;
+    double position = 0.0;
+    int side = +1;          // the real nodes lie above (+1) or below (-1) the plane along `axis`
+    bool lift_off = false;  // pairs with its ghosts may only push (a rigid plane with lift-off)
+    bool rigid = false;     // a rigid wall (its reaction is reported) rather than a symmetry plane
+
+    // Signed distance of a point's coordinate from the plane, positive on the real side.
+    double distance(double coordinate) const { return side * (coordinate - position); }
+};
+
+class GhostSet {
+public:
+    GhostSet() = default;
+    explicit GhostSet(std::vector<GhostPlane> planes);
+
+    const std::vector<GhostPlane>& planes() const { return planes_; }
+    std::vector<MirrorPlane> mirror_planes() const;
+    bool empty() const { return planes_.empty(); }
+    bool any_lift_off() const;
+
+    // Which real nodes touch each rigid plane (bit p of NodeStore::plane_contact). At the start,
+    // every node within 3/4 of its diameter of the plane; later, a free node comes into contact
+    // when it is that close and moving towards the plane. On a lift-off plane a node in contact
+    // is released when its normal stress sigma_nn (with viscosity) turns tensile; on a
+    // no-lift-off plane it stays. Decided before the neighbour lists, so that the gradient and
+    // the forces see the same ghost pairs (and the energy identity holds).
+    void update_contacts(NodeStore& nodes, std::size_t real_count, bool initial) const;
+
+    // The sliding condition of rigid planes (the paper's "nodes on the rigid surface"): a node in
+    // contact loses its normal velocity towards the plane, and on a no-lift-off plane also away
+    // from it. Returns the kinetic energy removed (J) and adds the momentum removed to
+    // `impulse[p]` (normal component, per plane).
+    double constrain_contact_velocities(NodeStore& nodes, std::size_t real_count, std::vector<double>& impulse) const;
+
+    // Replaces the ghosts of `nodes` (everything after real_count) with the mirrors of the real
+    // nodes within `range` of the planes (all planes of a corner mask) and of every node that a
+    // fixed list names as a mirrored neighbour; across a lift-off plane only nodes in contact
+    // have ghosts. Copies positions, velocities and the geometry fields (mass, volume, size
+    // weight, diameter, connectivity, body, material, failed).
+    void build(NodeStore& nodes, std::size_t real_count, double range);
+
+    // Removes from the real centres' rows [0, real_count) the ghosts of lift-off planes that the
+    // centre does not touch, so that only nodes in contact interact with those ghosts.
+    void remove_pairs_without_contact(CompressedRows& lists, const NodeStore& nodes, std::size_t real_count) const;
+
+    // Copies the fields of the stress phase and the gradient from the sources: alpha, stress
+    // (mirrored), pressure, viscous pressure, sound speed, volume, damage, failed.
+    void refresh(NodeStore& nodes, std::size_t real_count) const;
+
+    // For every real node, the ghost indices of its mirrored lattice neighbours
+    // (NodeStore::fixed_mirrors resolved against the current ghosts).
+    const CompressedRows& resolved_fixed_mirrors(const NodeStore& nodes, std::size_t real_count);
+
+    // Appends the rows of the ghost centres to `lists` (which holds the rows of the real
+    // centres): ghost g = mirror(s, S) lists every real j whose mirror(j, S) is in s's list, so
+    // that each real-ghost pair has its mirror image.
+    void append_ghost_rows(CompressedRows& lists, std::size_t real_count) const;
+
+    std::size_t count() const { return source_.size(); }
+    NodeIndex source(std::size_t ghost) const { return source_[ghost]; }
+    std::uint8_t planes_of(std::size_t ghost) const { return mask_[ghost]; }
+
+    // The force the planes exert on the real nodes along each plane's normal, from the forces
+    // on the ghosts (spec section 7: the net force over all real-ghost pairs). Positive pushes
+    // the bodies away from the plane.
+    std::vector<double> normal_reactions(const NodeStore& nodes, std::size_t real_count) const;
+
+private:
+    std::vector<GhostPlane> planes_;
+    std::vector<std::uint8_t> masks_;            // the corner combinations in use: distinct axes
+    std::vector<std::vector<std::int64_t>> index_;  // per mask slot, per real node: ghost node or -1
+    std::vector<NodeIndex> source_;
+    std::vector<std::uint8_t> mask_;
+    std::uint8_t lift_off_mask_ = 0;  // bits of the lift-off planes
+    std::uint8_t rigid_mask_ = 0;     // bits of the rigid planes (lift-off or not)
+    CompressedRows resolved_;
+    std::size_t mask_slot(std::uint8_t mask) const;
+    // True when real node i may have (or be paired with) ghosts across the planes of `mask`.
+    bool allowed(const NodeStore& nodes, std::size_t i, std::uint8_t mask) const {
+        return (mask & lift_off_mask_ & ~nodes.plane_contact[i]) == 0;
+    }
+};
+
+// Mirrors a symmetric stress (NodeStore order) across a plane normal to `axis`: the shear
+// components with exactly one index along the normal change sign.
+void mirror_stress(int dim, int axis, std::array<double, 6>& s);
+
+}  // namespace gpa

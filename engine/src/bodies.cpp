@@ -1,0 +1,179 @@
+#include "gpa/engine/bodies.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "gpa/engine/errors.hpp"
+
+namespace gpa {
+
+std::size_t material_index(const Scene& scene, const std::string& name, const std::string& body) {
+    for (std::size_t m = 0; m < scene.materials.size(); ++m) {
+        if (scene.materials[m].name == name) return m;
+    }
+    throw InputError(fmt::format("body \"{}\": unknown material \"{}\"", body, name));
+}
+
+namespace {
+
+// Cells across an extent and the spacing that fits it exactly.
+std::pair<std::int64_t, double> fit(double extent, double spacing, const std::string& body, const char* what) {
+    if (!(extent > 0.0) || !(spacing > 0.0) || !std::isfinite(extent) || !std::isfinite(spacing)) {
+        throw InputError(fmt::format("body \"{}\": {} {} m and spacing {} m must be positive", body, what, extent, spacing));
+    }
+    const double cells = std::max(1.0, std::round(extent / spacing));
+    if (cells > 1e7) throw InputError(fmt::format("body \"{}\": {} needs {} lattice cells", body, what, cells));
+    return {static_cast<std::int64_t>(cells), extent / cells};
+}
+
+}  // namespace
+
+LatticeBlock body_lattice(const Scene& scene, std::size_t index) {
+    const BodySpec& b = scene.bodies.at(index);
+    const int dim = dimension_of(scene.geometry);
+    const bool axisymmetric = scene.geometry == GeometryKind::Axisymmetric;
+    LatticeBlock block;
+    const double dx = b.spacing;
+    const double dz = dim == 2 && b.spacing_z > 0.0 ? b.spacing_z : dx;
+    const auto& o = b.origin;
+    if (dim == 2) {
+        switch (b.shape) {
+            case ShapeKind::Cylinder:
+            case ShapeKind::Plate: {
+                const auto [nz, sz] = fit(b.length, dz, b.name, "length");
+                const auto [nx, sx] = fit(axisymmetric ? b.radius : 2.0 * b.radius, dx, b.name, axisymmetric ? "radius" : "diameter");
+                block.origin = {axisymmetric ? 0.0 : o[0] - b.radius, o[1], 0.0};
+                block.spacing = {sx, sz, 1.0};
+                block.last = {nx, nz, 1};
+                break;
+            }
+            case ShapeKind::Rectangle: {
+                const auto [nx, sx] = fit(b.size[0], dx, b.name, "width (x)");
+                const auto [nz, sz] = fit(b.size[1], dz, b.name, "height (z)");
+                block.origin = {o[0], o[1], 0.0};
+                block.spacing = {sx, sz, 1.0};
+                block.last = {nx, nz, 1};
+                break;
+            }
+            case ShapeKind::Sphere: {
+                const auto [n, s] = fit(axisymmetric ? b.radius : 2.0 * b.radius, dx, b.name, "radius");
+                const double r = b.radius, cx = axisymmetric ? 0.0 : o[0], cz = o[1];
+                const std::int64_t nz = axisymmetric ? 2 * n : n;
+                block.origin = {axisymmetric ? 0.0 : cx - r, cz - r, 0.0};
+                block.spacing = {s, s, 1.0};
+                block.last = {n, nz, 1};
+                block.inside = [=](const std::array<double, 3>& p) {
+                    return (p[0] - cx) * (p[0] - cx) + (p[1] - cz) * (p[1] - cz) < r * r;
+                };
+                break;
+            }
+            case ShapeKind::Box:
+                throw InputError(fmt::format("body \"{}\": a box is a 3D shape; use a rectangle in 2D", b.name));
+        }
+    } else {
+        switch (b.shape) {
+            case ShapeKind::Cylinder:
+            case ShapeKind::Plate: {
+                const auto [nz, s] = fit(b.length, dx, b.name, "length");
+                const std::int64_t half = static_cast<std::int64_t>(std::ceil(b.radius / s - 1e-9));
+                const double r = b.radius, cx = o[0], cy = o[1];
+                block.origin = {cx, cy, o[2]};
+                block.spacing = {s, s, s};
+                block.first = {-half, -half, 0};
+                block.last = {half, half, nz};
+                block.inside = [=](const std::array<double, 3>& p) {
+                    return (p[0] - cx) * (p[0] - cx) + (p[1] - cy) * (p[1] - cy) < r * r;
+                };
+                break;
+            }
+            case ShapeKind::Box: {
+                const auto [nz, s] = fit(b.size[2], dx, b.name, "size z");
+                block.origin = o;
+                block.spacing = {s, s, s};
+                block.last = {std::max<std::int64_t>(1, std::llround(b.size[0] / s)),
+                              std::max<std::int64_t>(1, std::llround(b.size[1] / s)), nz};
+                break;
+            }
+            case ShapeKind::Sphere: {
+                const auto [n, s] = fit(2.0 * b.radius, dx, b.name, "diameter");
+                const double r = b.radius;
+                const auto c = o;
+                block.origin = {c[0] - r, c[1] - r, c[2] - r};
+                block.spacing = {s, s, s};
+                block.last = {n, n, n};
+                block.inside = [=](const std::array<double, 3>& p) {
+                    double q = 0.0;
+                    for (int k = 0; k < 3; ++k) q += (p[k] - c[k]) * (p[k] - c[k]);
+                    return q < r * r;
+                };
+                break;
+            }
+            case ShapeKind::Rectangle:
+                throw InputError(fmt::format("body \"{}\": a rectangle is a 2D shape; use a box in 3D", b.name));
+        }
+    }
+    return block;
+}
+
+namespace {
+
+// The initial volumetric strain that puts the equation of state at pressure p (e = 0): the
+// mean stress of a body's initial stress. Bisection on eps_v in (-0.5, 1).
+double strain_for_pressure(const materials::Material& m, double p, const std::string& body) {
+    if (p == 0.0) return 0.0;
+    const auto pressure_at = [&](double eps_v) {
+        return materials::evaluate_eos(m.eos, m.density, m.density / (1.0 + eps_v), 0.0).pressure;
+    };
+    double lo = -0.5, hi = 1.0;
+    if ((pressure_at(lo) - p) * (pressure_at(hi) - p) > 0.0) {
+        throw InputError(fmt::format("body \"{}\": initial mean stress {} Pa is beyond what the equation of state of "
+                                     "\"{}\" reaches", body, -p, m.name));
+    }
+    for (int k = 0; k < 200; ++k) {
+        const double mid = 0.5 * (lo + hi);
+        // pressure falls as eps_v grows (expansion)
+        if (pressure_at(mid) > p) lo = mid; else hi = mid;
+    }
+    return 0.5 * (lo + hi);
+}
+
+}  // namespace
+
+std::size_t add_body_nodes(NodeStore& nodes, const Scene& scene, std::size_t index, const std::vector<MirrorPlane>& mirrors) {
+    const BodySpec& b = scene.bodies.at(index);
+    const std::size_t material = material_index(scene, b.material, b.name);
+    const auto& mat = scene.materials[material];
+    LatticeBlock block = body_lattice(scene, index);
+    block.density = mat.density;
+    block.velocity = b.velocity;
+    block.body = static_cast<std::int32_t>(index);
+    block.material = static_cast<std::int32_t>(material);
+    const ConnectivityMode mode = b.connectivity.value_or(scene.solver.connectivity);
+    block.connectivity = mode == ConnectivityMode::Variable ? Connectivity::Variable : Connectivity::Fixed;
+    const int dim = nodes.dim();
+    block.lattice_neighbours = b.lattice_neighbours ? b.lattice_neighbours : (dim == 3 ? 26 : 8);
+    block.mirror_planes = mirrors;
+    const std::size_t first = fill_lattice(nodes, block);
+    if (nodes.size() == first) {
+        throw InputError(fmt::format("body \"{}\": its lattice holds no node (spacing {} m too coarse for its size)", b.name, b.spacing));
+    }
+    // Initial stress: deviator into s, mean stress into an initial compression.
+    const auto& sig = b.initial_stress;
+    const double mean = dim == 2 ? (sig[0] + sig[1] + sig[3]) / 3.0 : (sig[0] + sig[1] + sig[2]) / 3.0;
+    const double eps_v = strain_for_pressure(mat, -mean, b.name);
+    for (std::size_t i = first; i < nodes.size(); ++i) {
+        for (int c = 0; c < stress_components(dim); ++c) {
+            const bool normal = dim == 2 ? (c != 2) : (c < 3);
+            nodes.deviatoric_stress[c][i] = sig[c] - (normal ? mean : 0.0);
+        }
+        nodes.volumetric_strain[i] = eps_v;
+        nodes.volume[i] = nodes.initial_volume[i] * (1.0 + eps_v);
+        nodes.temperature[i] = mat.room_temperature;
+    }
+    update_size_weights(nodes, first, nodes.size());
+    return first;
+}
+
+}  // namespace gpa

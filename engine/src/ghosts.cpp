@@ -1,0 +1,302 @@
+#include "gpa/engine/ghosts.hpp"
+
+#include <algorithm>
+#include <bit>
+
+#include <fmt/format.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include "gpa/engine/errors.hpp"
+
+namespace gpa {
+
+void mirror_stress(int dim, int axis, std::array<double, 6>& s) {
+    if (dim == 2) {
+        s[2] = -s[2];  // xz: one index along x or along z, whichever the normal is
+        return;
+    }
+    // 3D order xx, yy, zz, yz, xz, xy
+    switch (axis) {
+        case 0: s[4] = -s[4]; s[5] = -s[5]; break;
+        case 1: s[3] = -s[3]; s[5] = -s[5]; break;
+        default: s[3] = -s[3]; s[4] = -s[4]; break;
+    }
+}
+
+GhostSet::GhostSet(std::vector<GhostPlane> planes) : planes_(std::move(planes)) {
+    if (planes_.size() > 8) throw InputError(fmt::format("at most 8 planes with ghosts, got {}", planes_.size()));
+    // Every non-empty combination of planes with distinct normals (corners and edges).
+    for (unsigned m = 1; m < (1u << planes_.size()); ++m) {
+        int axes = 0;
+        bool distinct = true;
+        for (std::size_t p = 0; p < planes_.size(); ++p) {
+            if (!((m >> p) & 1u)) continue;
+            if (axes & (1 << planes_[p].axis)) distinct = false;
+            axes |= 1 << planes_[p].axis;
+        }
+        if (distinct) masks_.push_back(static_cast<std::uint8_t>(m));
+    }
+    std::stable_sort(masks_.begin(), masks_.end(), [](std::uint8_t a, std::uint8_t b) { return std::popcount(a) < std::popcount(b); });
+    index_.resize(masks_.size());
+    for (std::size_t p = 0; p < planes_.size(); ++p) {
+        if (planes_[p].lift_off) lift_off_mask_ |= static_cast<std::uint8_t>(1u << p);
+        if (planes_[p].rigid) rigid_mask_ |= static_cast<std::uint8_t>(1u << p);
+    }
+}
+
+double GhostSet::constrain_contact_velocities(NodeStore& nodes, std::size_t real_count, std::vector<double>& impulse) const {
+    if (rigid_mask_ == 0) return 0.0;
+    impulse.resize(planes_.size(), 0.0);
+    double removed = 0.0;
+    // Serial: few nodes touch a plane, and the sums keep one order.
+    for (std::size_t i = 0; i < real_count; ++i) {
+        const std::uint8_t touching = nodes.plane_contact[i] & rigid_mask_;
+        if (touching == 0) continue;
+        for (std::size_t p = 0; p < planes_.size(); ++p) {
+            if (!((touching >> p) & 1u)) continue;
+            double& v = nodes.velocity[planes_[p].axis][i];
+            const double outward = planes_[p].side * v;  // > 0: leaving the plane
+            if (outward < 0.0 || (!planes_[p].lift_off && outward > 0.0)) {
+                removed += 0.5 * nodes.mass[i] * v * v;
+                impulse[p] -= nodes.mass[i] * outward;
+                v = 0.0;
+            }
+        }
+    }
+    return removed;
+}
+
+void GhostSet::update_contacts(NodeStore& nodes, std::size_t real_count, bool initial) const {
+    if (rigid_mask_ == 0) return;
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, real_count, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+            std::uint8_t bits = nodes.plane_contact[i];
+            for (std::size_t p = 0; p < planes_.size(); ++p) {
+                if (!planes_[p].rigid) continue;
+                const auto bit = static_cast<std::uint8_t>(1u << p);
+                const int a = planes_[p].axis;
+                const double gap = planes_[p].distance(nodes.position[a][i]);
+                const bool close = gap < 0.75 * nodes.diameter[i];
+                if (initial) {
+                    bits = close ? (bits | bit) : (bits & ~bit);
+                } else if (bits & bit) {
+                    if (planes_[p].lift_off) {
+                        // sigma_nn = s_nn - P - Q: tension (> 0) releases the node.
+                        const double normal_stress =
+                            nodes.deviatoric_stress[a][i] - nodes.pressure[i] - nodes.viscous_pressure[i];
+                        if (normal_stress > 0.0 || !close) bits &= static_cast<std::uint8_t>(~bit);
+                    }
+                } else if (close && planes_[p].side * nodes.velocity[a][i] < 0.0) {
+                    bits |= bit;
+                }
+            }
+            nodes.plane_contact[i] = bits;
+        }
+    });
+}
+
+void GhostSet::remove_pairs_without_contact(CompressedRows& lists, const NodeStore& nodes, std::size_t real_count) const {
+    if (lift_off_mask_ == 0) return;
+    std::size_t out = 0, start = 0;
+    for (std::size_t i = 0; i < real_count; ++i) {
+        const std::size_t end = lists.offsets[i + 1];
+        for (std::size_t e = start; e < end; ++e) {
+            const NodeIndex j = lists.indices[e];
+            if (j >= real_count && !allowed(nodes, i, mask_[j - real_count])) continue;
+            lists.indices[out++] = j;
+        }
+        start = end;
+        lists.offsets[i + 1] = out;
+    }
+    lists.indices.resize(out);
+}
+
+std::vector<MirrorPlane> GhostSet::mirror_planes() const {
+    std::vector<MirrorPlane> out;
+    for (std::size_t p = 0; p < planes_.size(); ++p) {
+        out.push_back({planes_[p].axis, planes_[p].position, planes_[p].side, static_cast<int>(p)});
+    }
+    return out;
+}
+
+bool GhostSet::any_lift_off() const {
+    return std::any_of(planes_.begin(), planes_.end(), [](const GhostPlane& p) { return p.lift_off; });
+}
+
+std::size_t GhostSet::mask_slot(std::uint8_t mask) const {
+    const auto it = std::find(masks_.begin(), masks_.end(), mask);
+    if (it == masks_.end()) throw NumericalError(fmt::format("ghost mask {} combines planes with the same normal", mask));
+    return static_cast<std::size_t>(it - masks_.begin());
+}
+
+void GhostSet::build(NodeStore& nodes, std::size_t real_count, double range) {
+    source_.clear();
+    mask_.clear();
+    if (planes_.empty()) {
+        nodes.resize(real_count);
+        return;
+    }
+    const int dim = nodes.dim();
+    // Which (source, mask) pairs are needed: nodes near all planes of a mask, and both ends of
+    // every mirrored lattice pair.
+    std::vector<std::vector<std::uint8_t>> needed(masks_.size(), std::vector<std::uint8_t>(real_count, 0));
+    for (std::size_t slot = 0; slot < masks_.size(); ++slot) {
+        const std::uint8_t m = masks_[slot];
+        auto& want = needed[slot];
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, real_count, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
+            for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                bool near = allowed(nodes, i, m);
+                for (std::size_t p = 0; p < planes_.size() && near; ++p) {
+                    if ((m >> p) & 1u) near = planes_[p].distance(nodes.position[planes_[p].axis][i]) < range;
+                }
+                want[i] = near;
+            }
+        });
+    }
+    for (std::size_t i = 0; i < real_count; ++i) {
+        if (nodes.connectivity[i] != Connectivity::Fixed) continue;
+        for (std::size_t k = nodes.fixed_mirrors.offsets[i]; k < nodes.fixed_mirrors.offsets[i + 1]; ++k) {
+            const std::uint8_t m = nodes.fixed_mirror_planes[k];
+            const NodeIndex j = nodes.fixed_mirrors.indices[k];
+            if (!allowed(nodes, i, m) || !allowed(nodes, j, m)) continue;
+            const std::size_t slot = mask_slot(m);
+            needed[slot][j] = 1;
+            needed[slot][i] = 1;
+        }
+    }
+    for (std::size_t slot = 0; slot < masks_.size(); ++slot) {
+        index_[slot].assign(real_count, -1);
+        for (std::size_t i = 0; i < real_count; ++i) {
+            if (!needed[slot][i]) continue;
+            index_[slot][i] = static_cast<std::int64_t>(real_count + source_.size());
+            source_.push_back(static_cast<NodeIndex>(i));
+            mask_.push_back(masks_[slot]);
+        }
+    }
+    const std::size_t ghosts = source_.size();
+    nodes.resize(real_count + ghosts);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, ghosts, 2048), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t k = r.begin(); k != r.end(); ++k) {
+            const std::size_t g = real_count + k, s = source_[k];
+            for (int c = 0; c < dim; ++c) {
+                nodes.position[c][g] = nodes.position[c][s];
+                nodes.velocity[c][g] = nodes.velocity[c][s];
+            }
+            for (std::size_t p = 0; p < planes_.size(); ++p) {
+                if (!((mask_[k] >> p) & 1u)) continue;
+                const int a = planes_[p].axis;
+                nodes.position[a][g] = 2.0 * planes_[p].position - nodes.position[a][g];
+                nodes.velocity[a][g] = -nodes.velocity[a][g];
+            }
+            nodes.mass[g] = nodes.mass[s];
+            nodes.volume[g] = nodes.volume[s];
+            nodes.initial_volume[g] = nodes.initial_volume[s];
+            nodes.size_weight[g] = nodes.size_weight[s];  // a ghost across the axis keeps its source's A_j > 0
+            nodes.diameter[g] = nodes.diameter[s];
+            nodes.initial_diameter[g] = nodes.initial_diameter[s];
+            nodes.connectivity[g] = nodes.connectivity[s];
+            nodes.body[g] = nodes.body[s];
+            nodes.material[g] = nodes.material[s];
+            nodes.failed[g] = nodes.failed[s];
+        }
+    });
+    refresh(nodes, real_count);
+}
+
+void GhostSet::refresh(NodeStore& nodes, std::size_t real_count) const {
+    const int dim = nodes.dim();
+    const int comps = stress_components(dim);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, source_.size(), 2048), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t k = r.begin(); k != r.end(); ++k) {
+            const std::size_t g = real_count + k, s = source_[k];
+            std::array<double, 6> stress{};
+            for (int c = 0; c < comps; ++c) stress[c] = nodes.deviatoric_stress[c][s];
+            for (std::size_t p = 0; p < planes_.size(); ++p) {
+                if ((mask_[k] >> p) & 1u) mirror_stress(dim, planes_[p].axis, stress);
+            }
+            for (int c = 0; c < comps; ++c) nodes.deviatoric_stress[c][g] = stress[c];
+            for (int c = 0; c < dim; ++c) nodes.alpha[c][g] = nodes.alpha[c][s];
+            nodes.pressure[g] = nodes.pressure[s];
+            nodes.viscous_pressure[g] = nodes.viscous_pressure[s];
+            nodes.sound_speed[g] = nodes.sound_speed[s];
+            nodes.volume[g] = nodes.volume[s];
+            nodes.damage[g] = nodes.damage[s];
+            nodes.failed[g] = nodes.failed[s];
+            nodes.smallest_h[g] = nodes.smallest_h[s];
+        }
+    });
+}
+
+const CompressedRows& GhostSet::resolved_fixed_mirrors(const NodeStore& nodes, std::size_t real_count) {
+    resolved_.offsets.assign(1, 0);
+    resolved_.indices.clear();
+    for (std::size_t i = 0; i < real_count; ++i) {
+        const bool fixed = nodes.connectivity[i] == Connectivity::Fixed;  // variable nodes find their ghosts by search
+        for (std::size_t k = nodes.fixed_mirrors.offsets[i]; fixed && k < nodes.fixed_mirrors.offsets[i + 1]; ++k) {
+            const std::uint8_t m = nodes.fixed_mirror_planes[k];
+            const NodeIndex j = nodes.fixed_mirrors.indices[k];
+            if (!allowed(nodes, i, m) || !allowed(nodes, j, m)) continue;  // not touching a lift-off plane
+            const std::int64_t g = index_[mask_slot(m)][j];
+            if (g < 0) throw NumericalError(fmt::format("node {}: its mirrored lattice neighbour has no ghost", i));
+            resolved_.indices.push_back(static_cast<NodeIndex>(g));
+        }
+        resolved_.offsets.push_back(resolved_.indices.size());
+    }
+    return resolved_;
+}
+
+void GhostSet::append_ghost_rows(CompressedRows& lists, std::size_t real_count) const {
+    const std::size_t ghosts = source_.size();
+    if (lists.rows() != real_count) {
+        throw NumericalError(fmt::format("append_ghost_rows: {} rows for {} real nodes", lists.rows(), real_count));
+    }
+    // Ghost centre mirror(s, S) gets real j for every entry mirror(j, S) of s's list.
+    const auto target = [&](std::size_t s, NodeIndex entry) -> std::int64_t {
+        const std::size_t k = entry - real_count;
+        return index_[mask_slot(mask_[k])][s];
+    };
+    std::vector<std::size_t> count(ghosts + 1, 0);
+    for (std::size_t s = 0; s < real_count; ++s) {
+        for (NodeIndex j : lists.row(s)) {
+            if (j < real_count) continue;
+            const std::int64_t t = target(s, j);
+            if (t < 0) {
+                throw NumericalError(fmt::format(
+                    "node {} lists a ghost whose mirror pair is missing (the ghost range is too short)", s));
+            }
+            ++count[static_cast<std::size_t>(t) - real_count + 1];
+        }
+    }
+    const std::size_t base = lists.entries();
+    lists.offsets.resize(real_count + ghosts + 1);
+    for (std::size_t k = 0; k < ghosts; ++k) {
+        count[k + 1] += count[k];
+        lists.offsets[real_count + k + 1] = base + count[k + 1];
+    }
+    lists.indices.resize(base + count[ghosts]);
+    std::vector<std::size_t> next(ghosts);
+    for (std::size_t k = 0; k < ghosts; ++k) next[k] = base + count[k];
+    for (std::size_t s = 0; s < real_count; ++s) {
+        for (std::size_t e = lists.offsets[s]; e < lists.offsets[s + 1]; ++e) {
+            const NodeIndex j = lists.indices[e];
+            if (j < real_count) continue;
+            const std::size_t t = static_cast<std::size_t>(target(s, j)) - real_count;
+            lists.indices[next[t]++] = source_[j - real_count];
+        }
+    }
+}
+
+std::vector<double> GhostSet::normal_reactions(const NodeStore& nodes, std::size_t real_count) const {
+    std::vector<double> reaction(planes_.size(), 0.0);
+    for (std::size_t k = 0; k < source_.size(); ++k) {
+        for (std::size_t p = 0; p < planes_.size(); ++p) {
+            if ((mask_[k] >> p) & 1u) {
+                reaction[p] -= planes_[p].side * nodes.force[planes_[p].axis][real_count + k];
+            }
+        }
+    }
+    return reaction;
+}
+
+}  // namespace gpa

@@ -1,0 +1,514 @@
+#include "gpa/engine/simulation.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+
+#include <fmt/format.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+
+#include "gpa/engine/bodies.hpp"
+#include "gpa/engine/colouring.hpp"
+#include "gpa/engine/drivers.hpp"
+#include "gpa/engine/errors.hpp"
+#include "gpa/engine/ghosts.hpp"
+#include "gpa/engine/kernels.hpp"
+#include "gpa/engine/neighbours.hpp"
+#include "gpa/engine/parallel.hpp"
+#include "gpa/engine/smoothing.hpp"
+#include "gpa/engine/stress.hpp"
+
+namespace gpa {
+
+namespace {
+
+constexpr std::size_t reduce_grain = 4096;  // fixed, so that every sum has one order on any thread count
+
+struct Sums {
+    double kinetic = 0.0, internal = 0.0, plastic = 0.0, viscous = 0.0;
+    std::array<double, 3> momentum{0, 0, 0};
+    double length = -std::numeric_limits<double>::infinity();
+    double footprint_hi = -std::numeric_limits<double>::infinity();
+    double footprint_lo = std::numeric_limits<double>::infinity();
+    std::size_t variable = 0, failed = 0;
+
+    Sums& operator+=(const Sums& o) {
+        kinetic += o.kinetic;
+        internal += o.internal;
+        plastic += o.plastic;
+        viscous += o.viscous;
+        for (int c = 0; c < 3; ++c) momentum[c] += o.momentum[c];
+        length = std::max(length, o.length);
+        footprint_hi = std::max(footprint_hi, o.footprint_hi);
+        footprint_lo = std::min(footprint_lo, o.footprint_lo);
+        variable += o.variable;
+        failed += o.failed;
+        return *this;
+    }
+};
+
+PositionView positions_of(const NodeStore& n) {
+    PositionView v;
+    v.dim = n.dim();
+    for (int c = 0; c < n.dim(); ++c) v.component[c] = n.position[c].data();
+    return v;
+}
+
+}  // namespace
+
+struct Simulation::Impl {
+    Scene scene;
+    ThreadScope threads;
+    NodeStore nodes;
+    std::size_t real = 0;
+    GhostSet ghosts;
+    std::vector<std::size_t> rigid_planes;  // ghost-plane index of each rigid plane of the scene
+    std::vector<ConnectivityMode> body_mode;
+    std::vector<std::vector<NodeIndex>> material_groups;
+    CompressedRows lists;
+    bool lists_constant = false;  // all fixed, one body, no ghosts: the lists never change
+    NeighbourScratch search_scratch;
+    ScatterPlan plan;
+    SmoothingScratch smoothing_scratch;
+    std::vector<double> bond_power;
+    std::unique_ptr<PhaseGraph> graph;
+
+    double time = 0.0;
+    double dt_half = 0.0;  // dt^{n+1/2}: the step from t^n to t^{n+1}
+    double dt_next = 0.0;  // dt^{n+3/2}
+    std::size_t steps = 0;
+    double node_steps = 0.0;
+    double kinetic_half = 0.0;  // kinetic energy of the current half-step velocities
+    double boundary_work = 0.0, bond_work = 0.0;
+    std::vector<double> impulse;
+    std::vector<double> reaction;
+    Totals totals;
+    std::string stop_reason;
+
+    Impl(Scene s, int thread_count) : scene(std::move(s)), threads(thread_count), nodes(scene.geometry) {}
+
+    int dim() const { return nodes.dim(); }
+    double a() const { return scene.solver.influence_distance; }
+
+    template <class G>
+    void setup();
+    template <class G>
+    void build_phase_graph();
+
+    // --- phases ---------------------------------------------------------------------------
+    void move();
+    void reorder();
+    template <class G>
+    void geometry();
+    void neighbours();
+    template <class G>
+    void gradient();
+    template <class G>
+    void stress();
+    void switching();
+    void refresh_ghosts_and_plan();
+    void time_step();
+    template <class G>
+    void forces();
+    void integrate(double dt_avg);
+    template <class G>
+    void smoothing();
+    void sum_totals();
+    void regroup_materials();
+};
+
+template <class G>
+void Simulation::Impl::setup() {
+    validate_scene(scene);
+    check_influence_distance(a());
+    // Planes with ghosts: the axis of an axisymmetric scene first, then the scene's planes.
+    std::vector<GhostPlane> planes;
+    if (G::axisymmetric) planes.push_back({"axis", 0, 0.0, +1, false, false});
+    for (const auto& p : scene.planes) {
+        if (p.kind == PlaneKind::Rigid) rigid_planes.push_back(planes.size());
+        planes.push_back({p.name, p.axis, p.position, p.side, p.kind == PlaneKind::Rigid && p.lift_off,
+                          p.kind == PlaneKind::Rigid});
+    }
+    ghosts = GhostSet(planes);
+    impulse.assign(rigid_planes.size(), 0.0);
+    reaction.assign(rigid_planes.size(), 0.0);
+    const auto mirrors = ghosts.mirror_planes();
+    for (std::size_t b = 0; b < scene.bodies.size(); ++b) {
+        add_body_nodes(nodes, scene, b, mirrors);
+        body_mode.push_back(scene.bodies[b].connectivity.value_or(scene.solver.connectivity));
+    }
+    real = nodes.size();
+    validate_nodes(nodes, 0, real);
+    for (const auto& m : scene.materials) materials::validate(m);
+    initialise_material_state(nodes, real, scene.materials);
+    if (scene.solver.reorder_interval > 0) reorder();
+    regroup_materials();
+    lists_constant = ghosts.empty() && !needs_search(nodes, real) &&
+                     std::none_of(body_mode.begin(), body_mode.end(),
+                                  [](ConnectivityMode m) { return m == ConnectivityMode::Automatic; });
+
+    // Geometry, neighbours, geometry factors and forces at t = 0; then the first half step.
+    geometry<G>();
+    neighbours();
+    gradient<G>();
+    refresh_ghosts_and_plan();
+    // The first step: dt from the initial state, velocities advance half a step (spec section 11).
+    dt_half = 0.0;
+    time_step();
+    sum_totals();
+    const double kinetic_at_start = kinetic_half;
+    totals.initial_kinetic_energy = kinetic_at_start;
+    totals.initial_energy = kinetic_at_start + totals.internal_energy;
+    forces<G>();
+    integrate(0.5 * dt_next);
+    sum_totals();
+    totals.kinetic_energy = kinetic_at_start;  // at t = 0: the initial velocities themselves
+    totals.energy_error = 0.0;
+    dt_half = dt_next;
+    build_phase_graph<G>();
+}
+
+void Simulation::Impl::regroup_materials() {
+    material_groups.assign(scene.materials.size(), {});
+    for (std::size_t i = 0; i < real; ++i) material_groups[static_cast<std::size_t>(nodes.material[i])].push_back(static_cast<NodeIndex>(i));
+}
+
+void Simulation::Impl::reorder() {
+    nodes.resize(real);  // ghosts are rebuilt after every move
+    const double cell = largest_interaction_radius(nodes, a(), real);
+    nodes.permute(locality_order(nodes, cell, 0, real));
+    lists.clear();  // rebuilt in the new numbering by the neighbours phase
+    regroup_materials();
+}
+
+void Simulation::Impl::move() {
+    const int d = dim();
+    const double dt = dt_half;
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, real, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (int c = 0; c < d; ++c) {
+            double* x = nodes.position[c].data();
+            const double* v = nodes.velocity[c].data();
+            for (std::size_t i = r.begin(); i != r.end(); ++i) x[i] += dt * v[i];
+        }
+    });
+    time += dt;
+    // Penetration guard: a node that ends behind a plane is put back just in front of it and
+    // loses its velocity towards it; the kinetic energy and momentum it loses are booked as
+    // boundary work and plane impulse (spec section 7).
+    for (std::size_t p = 0; p < ghosts.planes().size(); ++p) {
+        const auto& plane = ghosts.planes()[p];
+        const auto rigid = std::find(rigid_planes.begin(), rigid_planes.end(), p);
+        for (std::size_t i = 0; i < real; ++i) {
+            double& x = nodes.position[plane.axis][i];
+            if (plane.distance(x) > 0.0) continue;
+            x = plane.position + plane.side * 0.01 * nodes.initial_diameter[i];
+            double& v = nodes.velocity[plane.axis][i];
+            if (plane.side * v < 0.0) {
+                boundary_work += 0.5 * nodes.mass[i] * v * v;
+                if (rigid != rigid_planes.end()) impulse[rigid - rigid_planes.begin()] -= plane.side * nodes.mass[i] * v;
+                v = 0.0;
+            }
+        }
+    }
+}
+
+template <class G>
+void Simulation::Impl::geometry() {
+    // Node diameters (Eq. 3) and size weights (Eq. 4) at the new positions, with the volumes of
+    // the previous stress update; the gradient and the next forces both use these.
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, real, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+            nodes.diameter[i] = node_diameter<G>(nodes.initial_diameter[i], nodes.volumetric_strain[i],
+                                                 nodes.initial_radius[i], nodes.position[0][i]);
+        }
+        update_size_weights(nodes, r.begin(), r.end());
+    });
+    if (!ghosts.empty()) {
+        ghosts.update_contacts(nodes, real, steps == 0 && time == 0.0);
+        ghosts.build(nodes, real, largest_interaction_radius(nodes, a(), real));
+    }
+}
+
+void Simulation::Impl::neighbours() {
+    if (lists_constant && lists.rows() == real) return;
+    if (ghosts.empty()) {
+        find_neighbours(nodes, a(), real, lists, search_scratch);
+        return;
+    }
+    const CompressedRows& mirrored = ghosts.resolved_fixed_mirrors(nodes, real);
+    find_neighbours(nodes, a(), real, lists, search_scratch, &mirrored);
+    ghosts.remove_pairs_without_contact(lists, nodes, real);
+    ghosts.append_ghost_rows(lists, real);
+}
+
+template <class G>
+void Simulation::Impl::gradient() {
+    auto f = gradient_fields<G::dim>(nodes, a());
+    f.alpha_limit = scene.solver.alpha_limit;
+    compute_velocity_gradient<G>(lists, scene.solver.weight, f, real);
+}
+
+template <class G>
+void Simulation::Impl::stress() {
+    StressPhaseOptions o;
+    o.nodal_viscosity = scene.solver.viscosity == ViscosityKind::Nodal;
+    o.viscosity_linear = scene.solver.viscosity_linear;
+    o.viscosity_quadratic = scene.solver.viscosity_quadratic;
+    o.failure = scene.solver.failure;
+    update_stresses<G>(nodes, real, scene.materials, material_groups, dt_half, o);
+}
+
+void Simulation::Impl::switching() {
+    // Paper section 6: a fixed node switches to variable connectivity, for the rest of the run,
+    // once its equivalent plastic strain exceeds the threshold.
+    const double threshold = scene.solver.switch_plastic_strain;
+    for (std::size_t i = 0; i < real; ++i) {
+        if (nodes.connectivity[i] == Connectivity::Fixed && body_mode[static_cast<std::size_t>(nodes.body[i])] == ConnectivityMode::Automatic &&
+            nodes.plastic_strain[i] > threshold) {
+            nodes.connectivity[i] = Connectivity::Variable;
+        }
+    }
+}
+
+void Simulation::Impl::refresh_ghosts_and_plan() {
+    if (!ghosts.empty()) ghosts.refresh(nodes, real);
+    plan = make_plan(scene.solver.scatter, lists, positions_of(nodes), nodes.size());
+}
+
+void Simulation::Impl::time_step() {
+    // Spec section 11, dt = C_cfl min_i h_i / (c_i + sqrt(Q_i / rho_i)), with h_i the node's stable
+    // length c / omega (kernels.hpp) in place of its smallest h_ij: h_ij ignores neighbours much
+    // closer than h and neighbourhoods that have thinned out along one axis, and runs with it were
+    // found unstable at any C_cfl above 0.1 once the impact face of a Taylor bar had spread.
+    const double limit = tbb::parallel_reduce(
+        tbb::blocked_range<std::size_t>(0, real, reduce_grain), std::numeric_limits<double>::infinity(),
+        [&](const tbb::blocked_range<std::size_t>& r, double best) {
+            for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                const double h = nodes.stable_length[i];
+                const double density = nodes.mass[i] / nodes.volume[i];
+                const double speed = nodes.sound_speed[i] + std::sqrt(std::max(nodes.viscous_pressure[i], 0.0) / density);
+                best = std::min(best, h / speed);
+            }
+            return best;
+        },
+        [](double x, double y) { return std::min(x, y); });
+    double dt = scene.solver.cfl * limit;
+    if (dt_half > 0.0) dt = std::min(dt, scene.solver.time_step_growth * dt_half);
+    dt = std::min(dt, scene.solver.max_time_step);
+    if (!(dt > 0.0) || !std::isfinite(dt)) {
+        throw NumericalError(fmt::format("the stable time step is {} s at t = {} s (a node has no size or no sound speed)", dt, time));
+    }
+    dt_next = dt;
+}
+
+template <class G>
+void Simulation::Impl::forces() {
+    auto f = force_fields<G::dim>(nodes, a());
+    f.hoop_count = real;
+    BondViscosityParameters bond{scene.solver.viscosity_linear, scene.solver.viscosity_quadratic, scene.solver.bond_viscosity_eps0};
+    const bool with_bond = scene.solver.viscosity == ViscosityKind::Bond;
+    if (with_bond) {
+        f.viscous_pressure = nullptr;
+        bond_power.assign(nodes.size(), 0.0);
+        f.bond_viscous_power = bond_power.data();
+    }
+    compute_forces<G>(lists, plan, scene.solver.weight, with_bond ? &bond : nullptr, f, nodes.size());
+    if (!ghosts.empty()) {
+        const auto all = ghosts.normal_reactions(nodes, real);
+        for (std::size_t k = 0; k < rigid_planes.size(); ++k) reaction[k] = all[rigid_planes[k]];
+    }
+}
+
+void Simulation::Impl::integrate(double dt_avg) {
+    // v^{n+3/2} = v^{n+1/2} + dt_avg F^{n+1} / M (spec section 11).
+    const int d = dim();
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, real, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (int c = 0; c < d; ++c) {
+            double* v = nodes.velocity[c].data();
+            const double* f = nodes.force[c].data();
+            for (std::size_t i = r.begin(); i != r.end(); ++i) v[i] += dt_avg * f[i] / nodes.mass[i];
+        }
+    });
+    for (std::size_t k = 0; k < reaction.size(); ++k) impulse[k] += reaction[k] * dt_avg;
+    if (!rigid_planes.empty()) {
+        // Sliding condition of the nodes on rigid planes; what it removes is booked.
+        std::vector<double> removed_momentum;
+        boundary_work += ghosts.constrain_contact_velocities(nodes, real, removed_momentum);
+        for (std::size_t k = 0; k < rigid_planes.size(); ++k) impulse[k] += removed_momentum[rigid_planes[k]];
+    }
+    if (scene.solver.viscosity == ViscosityKind::Bond) {
+        // The work of the bond-viscous forces becomes internal energy of the centre (spec section 5).
+        const double work = tbb::parallel_deterministic_reduce(
+            tbb::blocked_range<std::size_t>(0, real, reduce_grain), 0.0,
+            [&](const tbb::blocked_range<std::size_t>& r, double sum) {
+                for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                    const double heat = -bond_power[i] * dt_avg / nodes.mass[i];
+                    nodes.internal_energy[i] += heat;
+                    nodes.viscous_work[i] += heat;
+                    sum += heat * nodes.mass[i];
+                }
+                return sum;
+            },
+            [](double x, double y) { return x + y; });
+        bond_work += work;
+    }
+}
+
+template <class G>
+void Simulation::Impl::smoothing() {
+    SmoothingOptions o{scene.solver.smoothing_coefficient, scene.solver.smoothing == SmoothingMode::Tension};
+    std::array<double*, G::dim> v{};
+    for (int c = 0; c < G::dim; ++c) v[c] = nodes.velocity[c].data();
+    smooth_velocities<G>(lists, plan, scene.solver.weight, pair_fields<G::dim>(nodes, a()), real, o, v,
+                         nodes.mass.data(), nodes.pressure.data(), nodes.internal_energy.data(), smoothing_scratch);
+}
+
+void Simulation::Impl::sum_totals() {
+    const int d = dim();
+    const GhostPlane* plane = rigid_planes.empty() ? nullptr : &ghosts.planes()[rigid_planes.front()];
+    const bool axisymmetric = scene.geometry == GeometryKind::Axisymmetric;
+    const Sums s = tbb::parallel_deterministic_reduce(
+        tbb::blocked_range<std::size_t>(0, real, reduce_grain), Sums{},
+        [&](const tbb::blocked_range<std::size_t>& r, Sums acc) {
+            for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                const double m = nodes.mass[i];
+                double v2 = 0.0;
+                for (int c = 0; c < d; ++c) {
+                    v2 += nodes.velocity[c][i] * nodes.velocity[c][i];
+                    acc.momentum[c] += m * nodes.velocity[c][i];
+                }
+                acc.kinetic += 0.5 * m * v2;
+                acc.internal += m * nodes.internal_energy[i];
+                acc.plastic += m * nodes.plastic_work[i];
+                acc.viscous += m * nodes.viscous_work[i];
+                acc.variable += nodes.connectivity[i] == Connectivity::Variable;
+                acc.failed += nodes.failed[i] != 0;
+                if (plane) {
+                    const double dist = plane->distance(nodes.position[plane->axis][i]);
+                    const double half = 0.5 * nodes.diameter[i];
+                    acc.length = std::max(acc.length, dist + half);
+                    if (dist < nodes.diameter[i]) {
+                        // Width across the plane's first other axis (radius x in axisymmetric geometry).
+                        const int across = plane->axis == 0 ? 1 : 0;
+                        const double x = nodes.position[across][i];
+                        acc.footprint_hi = std::max(acc.footprint_hi, x + half);
+                        acc.footprint_lo = std::min(acc.footprint_lo, axisymmetric ? -(x + half) : x - half);
+                    }
+                }
+            }
+            return acc;
+        },
+        [](Sums x, const Sums& y) { return x += y; });
+    // Kinetic energy at an integer time: the mean of the half steps around it (spec section 11).
+    totals.kinetic_energy = 0.5 * (kinetic_half + s.kinetic);
+    kinetic_half = s.kinetic;
+    totals.internal_energy = s.internal;
+    totals.plastic_work = s.plastic;
+    totals.viscous_work = s.viscous;
+    totals.boundary_work = boundary_work;
+    totals.momentum = s.momentum;
+    totals.time = time;
+    totals.time_step = dt_half;
+    totals.step = steps;
+    totals.length = plane ? s.length : 0.0;
+    totals.footprint_diameter = plane && s.footprint_hi > s.footprint_lo ? s.footprint_hi - s.footprint_lo : 0.0;
+    totals.real_nodes = real;
+    totals.ghost_nodes = nodes.size() - real;
+    totals.variable_nodes = s.variable;
+    totals.failed_nodes = s.failed;
+    totals.pairs = lists.entries();
+    totals.planes.clear();
+    for (std::size_t k = 0; k < rigid_planes.size(); ++k) {
+        totals.planes.push_back({ghosts.planes()[rigid_planes[k]].name, reaction[k], impulse[k]});
+    }
+    if (totals.initial_energy != 0.0) {
+        totals.energy_error = (totals.kinetic_energy + totals.internal_energy + totals.boundary_work - totals.initial_energy) /
+                              totals.initial_energy;
+    }
+}
+
+template <class G>
+void Simulation::Impl::build_phase_graph() {
+    graph = std::make_unique<PhaseGraph>();
+    // The step, as drawn in simulation.hpp; bracketed phases only where the scene needs them.
+    graph->add("move", [this] { move(); });
+    if (scene.solver.reorder_interval > 0) {
+        graph->add("reorder", [this] {
+            if (steps % scene.solver.reorder_interval == 0 && steps > 0) reorder();
+        });
+    }
+    graph->add("geometry", [this] { geometry<G>(); });
+    graph->add("neighbours", [this] { neighbours(); });
+    graph->add("gradient", [this] { gradient<G>(); });
+    graph->add("stress", [this] { stress<G>(); });
+    if (std::any_of(body_mode.begin(), body_mode.end(), [](ConnectivityMode m) { return m == ConnectivityMode::Automatic; })) {
+        graph->add("switching", [this] { switching(); });
+    }
+    graph->add("plan", [this] { refresh_ghosts_and_plan(); });
+    graph->add("time step", [this] { time_step(); });
+    graph->add("forces", [this] { forces<G>(); });
+    graph->add("integrate", [this] { integrate(0.5 * (dt_half + dt_next)); });
+    if (scene.solver.smoothing != SmoothingMode::Off && scene.solver.smoothing_coefficient > 0.0) {
+        graph->add("smoothing", [this] { smoothing<G>(); });
+    }
+    graph->add("totals", [this] {
+        ++steps;
+        node_steps += static_cast<double>(real);
+        sum_totals();
+        dt_half = dt_next;
+    });
+}
+
+Simulation::Simulation(Scene scene, int threads) : impl_(std::make_unique<Impl>(std::move(scene), threads)) {
+    impl_->threads.run([this] {
+        dispatch_geometry(impl_->scene.geometry, [this](auto g) { impl_->setup<decltype(g)>(); });
+    });
+}
+
+Simulation::~Simulation() = default;
+
+void Simulation::step() {
+    if (finished()) return;
+    impl_->threads.run([this] { impl_->graph->run(); });
+}
+
+bool Simulation::finished() const {
+    const auto& s = impl_->scene.stop;
+    const auto& t = impl_->totals;
+    auto& reason = impl_->stop_reason;
+    if (s.end_time > 0.0 && impl_->time >= s.end_time * (1.0 - 1e-12)) {
+        reason = fmt::format("end time {:.6g} s reached", s.end_time);
+        return true;
+    }
+    if (s.kinetic_energy_fraction > 0.0 && impl_->steps > 0 &&
+        t.kinetic_energy < s.kinetic_energy_fraction * t.initial_kinetic_energy) {
+        reason = fmt::format("kinetic energy below {:g} % of its initial value", 100.0 * s.kinetic_energy_fraction);
+        return true;
+    }
+    if (s.max_steps > 0 && impl_->steps >= s.max_steps) {
+        reason = fmt::format("{} steps done", s.max_steps);
+        return true;
+    }
+    return false;
+}
+
+std::string Simulation::stop_reason() const {
+    (void)finished();
+    return impl_->stop_reason;
+}
+
+const Scene& Simulation::scene() const { return impl_->scene; }
+const NodeStore& Simulation::nodes() const { return impl_->nodes; }
+std::size_t Simulation::real_count() const { return impl_->real; }
+const Totals& Simulation::totals() const { return impl_->totals; }
+double Simulation::time() const { return impl_->time; }
+std::size_t Simulation::steps() const { return impl_->steps; }
+int Simulation::threads() const { return impl_->threads.threads(); }
+std::vector<PhaseTime> Simulation::phase_times() const { return impl_->graph->times(); }
+std::vector<std::string> Simulation::phases() const { return impl_->graph->names(); }
+double Simulation::node_steps() const { return impl_->node_steps; }
+
+}  // namespace gpa

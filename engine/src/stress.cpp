@@ -1,0 +1,173 @@
+#include "gpa/engine/stress.hpp"
+
+#include <atomic>
+#include <cmath>
+#include <limits>
+#include <mutex>
+#include <string>
+
+#include <fmt/format.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include "gpa/engine/errors.hpp"
+#include "gpa/engine/kernels.hpp"
+
+namespace gpa {
+
+template <class G>
+Eigen::Matrix3d full_velocity_gradient(const NodeStore& nodes, std::size_t i) {
+    constexpr int D = G::dim;
+    Eigen::Matrix3d L = Eigen::Matrix3d::Zero();
+    for (int a = 0; a < D; ++a) {
+        for (int b = 0; b < D; ++b) L(a, b) = nodes.velocity_gradient[a * D + b][i];
+    }
+    if constexpr (G::axisymmetric) L(2, 2) = nodes.velocity[0][i] / nodes.position[0][i];  // Eq. 9
+    return L;
+}
+
+namespace {
+
+// NodeStore stress order <-> the materials' (xx, yy, zz, yz, xz, xy). In 2D the materials'
+// axes are (x, z, out-of-plane), so the in-plane shear xz of the store is their "xy".
+template <int D>
+materials::Sym3 to_material(const NodeStore& n, std::size_t i) {
+    const auto& s = n.deviatoric_stress;
+    if constexpr (D == 2) {
+        return {s[0][i], s[1][i], s[3][i], 0.0, 0.0, s[2][i]};
+    } else {
+        return {s[0][i], s[1][i], s[2][i], s[3][i], s[4][i], s[5][i]};
+    }
+}
+
+template <int D>
+void from_material(NodeStore& n, std::size_t i, const materials::Sym3& m) {
+    auto& s = n.deviatoric_stress;
+    if constexpr (D == 2) {
+        s[0][i] = m[0];
+        s[1][i] = m[1];
+        s[3][i] = m[2];
+        s[2][i] = m[5];
+    } else {
+        for (int c = 0; c < 6; ++c) s[c][i] = m[c];
+    }
+}
+
+constexpr std::size_t no_node = std::numeric_limits<std::size_t>::max();
+
+}  // namespace
+
+template <class G>
+void update_stresses(NodeStore& nodes, std::size_t real_count, const std::vector<materials::Material>& materials,
+                     const std::vector<std::vector<NodeIndex>>& groups, double dt, const StressPhaseOptions& options) {
+    constexpr int D = G::dim;
+    std::atomic<std::size_t> collapsed{no_node};
+    std::mutex failure_mutex;  // taken only when a material update throws
+    std::size_t failed_node = no_node;
+    std::string failure;
+    for (std::size_t m = 0; m < groups.size(); ++m) {
+        const materials::Material& material = materials.at(m);
+        const auto& members = groups[m];
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, members.size(), 1024), [&](const tbb::blocked_range<std::size_t>& r) {
+            for (std::size_t k = r.begin(); k != r.end(); ++k) {
+                const std::size_t i = members[k];
+                if (i >= real_count) continue;
+                const double rate = nodes.volumetric_strain_rate[i];
+                const double density_old = nodes.mass[i] / nodes.volume[i];
+                // Eq. 13: eps_v in the initial configuration, then V = V0 (1 + eps_v).
+                const double eps_v = advance_volumetric_strain(nodes.volumetric_strain[i], rate, dt);
+                const double volume = nodes.initial_volume[i] * (1.0 + eps_v);
+                if (!(volume > 0.0) || !std::isfinite(volume)) {
+                    std::size_t seen = collapsed.load();
+                    while (i < seen && !collapsed.compare_exchange_weak(seen, i)) {
+                    }
+                    continue;
+                }
+                const double density_new = nodes.mass[i] / volume;
+                // Eq. 36: nodal viscosity from this step's volumetric strain rate.
+                const double q_new = options.nodal_viscosity
+                                         ? nodal_viscosity(rate, density_new, nodes.sound_speed[i], nodes.smallest_h[i],
+                                                           options.viscosity_linear, options.viscosity_quadratic)
+                                         : 0.0;
+                materials::PointState state;
+                state.deviatoric_stress = to_material<D>(nodes, i);
+                state.pressure = nodes.pressure[i];
+                state.specific_internal_energy = nodes.internal_energy[i];
+                state.plastic_strain = nodes.plastic_strain[i];
+                state.temperature = nodes.temperature[i];
+                state.damage = nodes.damage[i];
+                state.failed = nodes.failed[i] != 0;
+                materials::PointIncrement inc;
+                inc.velocity_gradient = full_velocity_gradient<G>(nodes, i);
+                inc.dt = dt;
+                inc.density_old = density_old;
+                inc.density_new = density_new;
+                inc.viscous_pressure_old = nodes.viscous_pressure[i];
+                inc.viscous_pressure_new = q_new;
+                inc.failure_enabled = options.failure;
+                materials::PointResult result;
+                try {
+                    result = materials::update_point(material, state, inc);
+                } catch (const std::exception& e) {
+                    const std::lock_guard<std::mutex> lock(failure_mutex);
+                    if (i < failed_node) {
+                        failed_node = i;
+                        failure = e.what();
+                    }
+                    continue;
+                }
+                from_material<D>(nodes, i, state.deviatoric_stress);
+                nodes.volumetric_strain[i] = eps_v;
+                nodes.volume[i] = volume;
+                nodes.viscous_pressure[i] = q_new;
+                nodes.pressure[i] = state.pressure;
+                nodes.internal_energy[i] = state.specific_internal_energy;
+                nodes.plastic_strain[i] = state.plastic_strain;
+                nodes.temperature[i] = state.temperature;
+                nodes.damage[i] = state.damage;
+                nodes.failed[i] = state.failed ? 1 : 0;
+                nodes.sound_speed[i] = result.sound_speed;
+                nodes.plastic_work[i] += result.plastic_work;
+                nodes.viscous_work[i] += result.viscous_work;
+            }
+        });
+    }
+    if (failed_node != no_node) {
+        const std::size_t i = failed_node;
+        throw NumericalError(fmt::format("node {} at ({:.6g}, {:.6g}) m, material \"{}\", t-step {:.3g} s: {}", i,
+                                         nodes.position[0][i], nodes.position[1][i],
+                                         materials.at(static_cast<std::size_t>(nodes.material[i])).name, dt, failure));
+    }
+    if (const std::size_t i = collapsed.load(); i != no_node) {
+        throw NumericalError(fmt::format(
+            "node {} at ({:.6g}, {:.6g}) m collapsed: its volume would become {:.3g} m^3 (volumetric strain "
+            "rate {:.3g} 1/s over dt = {:.3g} s); the time step is too large or the node was crushed",
+            i, nodes.position[0][i], nodes.position[1][i],
+            nodes.initial_volume[i] * (1.0 + advance_volumetric_strain(nodes.volumetric_strain[i], nodes.volumetric_strain_rate[i], dt)),
+            nodes.volumetric_strain_rate[i], dt));
+    }
+}
+
+void initialise_material_state(NodeStore& nodes, std::size_t real_count, const std::vector<materials::Material>& materials) {
+    for (std::size_t i = 0; i < real_count; ++i) {
+        const auto& m = materials.at(static_cast<std::size_t>(nodes.material[i]));
+        const double density = nodes.mass[i] / nodes.volume[i];
+        const auto eos = materials::evaluate_eos(m.eos, m.density, density, nodes.internal_energy[i]);
+        nodes.pressure[i] = eos.pressure;
+        const double k = std::max(eos.bulk_modulus, 0.0);
+        nodes.sound_speed[i] = std::sqrt((k + 4.0 * m.shear_modulus / 3.0) / density);
+        nodes.temperature[i] = m.room_temperature;
+    }
+}
+
+template void update_stresses<PlaneStrain>(NodeStore&, std::size_t, const std::vector<materials::Material>&,
+                                           const std::vector<std::vector<NodeIndex>>&, double, const StressPhaseOptions&);
+template void update_stresses<Axisymmetric>(NodeStore&, std::size_t, const std::vector<materials::Material>&,
+                                            const std::vector<std::vector<NodeIndex>>&, double, const StressPhaseOptions&);
+template void update_stresses<ThreeD>(NodeStore&, std::size_t, const std::vector<materials::Material>&,
+                                      const std::vector<std::vector<NodeIndex>>&, double, const StressPhaseOptions&);
+template Eigen::Matrix3d full_velocity_gradient<PlaneStrain>(const NodeStore&, std::size_t);
+template Eigen::Matrix3d full_velocity_gradient<Axisymmetric>(const NodeStore&, std::size_t);
+template Eigen::Matrix3d full_velocity_gradient<ThreeD>(const NodeStore&, std::size_t);
+
+}  // namespace gpa

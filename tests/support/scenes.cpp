@@ -1,0 +1,81 @@
+#include "support/scenes.hpp"
+
+namespace gpa::testing {
+
+materials::Material elastic_material(const std::string& name, double density, double young, double poisson) {
+    materials::Material m;
+    m.name = name;
+    m.density = density;
+    const double k = young / (3.0 * (1.0 - 2.0 * poisson));
+    m.shear_modulus = young / (2.0 * (1.0 + poisson));
+    m.eos = materials::LinearEos{k, false};
+    m.strength = materials::ElasticStrength{};
+    m.specific_heat = 450.0;
+    m.source = "test material";
+    return m;
+}
+
+Scene elastic_bar_on_plane(double radius, double length, int radial_cells, double speed) {
+    Scene s;
+    s.name = "elastic bar on a rigid plane";
+    s.geometry = GeometryKind::Axisymmetric;
+    s.materials.push_back(elastic_material("elastic steel", 7800.0, 200e9, 0.0));
+    BodySpec bar;
+    bar.name = "bar";
+    bar.shape = ShapeKind::Cylinder;
+    bar.radius = radius;
+    bar.length = length;
+    bar.spacing = radius / radial_cells;
+    bar.material = "elastic steel";
+    bar.velocity = {0.0, -speed, 0.0};
+    s.bodies.push_back(bar);
+    PlaneSpec wall;
+    wall.name = "anvil";
+    wall.kind = PlaneKind::Rigid;
+    wall.axis = 1;
+    wall.position = 0.0;
+    wall.side = +1;
+    wall.lift_off = true;
+    s.planes.push_back(wall);
+    s.solver.viscosity = ViscosityKind::None;
+    s.solver.connectivity = ConnectivityMode::Variable;
+    s.stop.end_time = 3.0 * length / 5000.0;
+    return s;
+}
+
+Scene armco_cylinder(int radial_cells, double end_time) {
+    Scene s;
+    s.name = "Armco iron cylinder impact";
+    s.geometry = GeometryKind::Axisymmetric;
+    materials::Material iron;
+    iron.name = "Armco iron";
+    iron.density = 7890.0;
+    iron.shear_modulus = 80e9;
+    iron.specific_heat = 452.0;
+    iron.room_temperature = 294.0;
+    iron.melt_temperature = 1811.0;
+    iron.eos = materials::PolynomialEos{165e9, 0.0, 0.0, 1.7};
+    iron.strength = materials::JohnsonCookStrength{175e6, 380e6, 0.32, 0.060, 0.55, 1.0};
+    iron.source = "materials.md";
+    s.materials.push_back(iron);
+    BodySpec bar;
+    bar.name = "cylinder";
+    bar.shape = ShapeKind::Cylinder;
+    bar.radius = 5.1e-3;
+    bar.length = 15.2e-3;
+    bar.spacing = bar.radius / radial_cells;
+    bar.material = "Armco iron";
+    bar.velocity = {0.0, -305.0, 0.0};
+    s.bodies.push_back(bar);
+    PlaneSpec wall;
+    wall.name = "anvil";
+    wall.kind = PlaneKind::Rigid;
+    wall.axis = 1;
+    wall.side = +1;
+    wall.lift_off = false;
+    s.planes.push_back(wall);
+    s.stop.end_time = end_time;
+    return s;
+}
+
+}  // namespace gpa::testing

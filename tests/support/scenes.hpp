@@ -1,0 +1,19 @@
+#pragma once
+// Scenes built in code for the engine's run tests.
+
+#include "gpa/engine/scene.hpp"
+
+namespace gpa::testing {
+
+// A linear-elastic material: linear EOS with K, shear modulus G, no yield.
+materials::Material elastic_material(const std::string& name, double density, double young, double poisson);
+
+// An axisymmetric bar of radius R and length L standing on a rigid plane at z = 0 (lift-off
+// allowed) and moving towards it at `speed`; spacing = R / radial_cells.
+Scene elastic_bar_on_plane(double radius, double length, int radial_cells, double speed);
+
+// The paper's Armco-iron cylinder (L0 15.2 mm, D0 10.2 mm, 305 m/s) at `radial_cells` across
+// the radius, nodal viscosity, no lift-off, with the given end time.
+Scene armco_cylinder(int radial_cells, double end_time);
+
+}  // namespace gpa::testing
