@@ -1,8 +1,355 @@
 #include "gpa/engine/scene.hpp"
 
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <exception>
+#include <string>
+#include <string_view>
+#include <utility>
+
+#include <fmt/format.h>
+
+#include "gpa/engine/errors.hpp"
+
+// The rules a scene must keep, for a scene read from a file and one built in code alike.
+// Messages use the scene file's key names (solver.cfl, body "bar" (body[0]).radius), which are
+// also the names of the Scene's fields.
+
 namespace gpa {
 
-// Placeholder until the scene checks land.
-void validate_scene(const Scene&) {}
+namespace {
+
+[[noreturn]] void fail(std::string message) { throw InputError(std::move(message)); }
+
+bool finite(double v) { return std::isfinite(v); }
+
+std::string body_label(const BodySpec& b, std::size_t i) {
+    return b.name.empty() ? fmt::format("body[{}]", i) : fmt::format("body \"{}\" (body[{}])", b.name, i);
+}
+
+std::string plane_label(const PlaneSpec& p, std::size_t i) {
+    return p.name.empty() ? fmt::format("plane[{}]", i) : fmt::format("plane \"{}\" (plane[{}])", p.name, i);
+}
+
+std::string material_label(const materials::Material& m, std::size_t i) {
+    return m.name.empty() ? fmt::format("material[{}]", i) : fmt::format("material \"{}\" (material[{}])", m.name, i);
+}
+
+bool same_name(std::string_view a, std::string_view b) {
+    return a.size() == b.size() && std::equal(a.begin(), a.end(), b.begin(), [](char x, char y) {
+               return std::tolower(static_cast<unsigned char>(x)) == std::tolower(static_cast<unsigned char>(y));
+           });
+}
+
+char axis_letter(int axis, int dim) {
+    if (dim == 2) return axis == 0 ? 'x' : 'z';
+    return axis == 0 ? 'x' : axis == 1 ? 'y' : 'z';
+}
+
+bool known_shape(ShapeKind s) {
+    switch (s) {
+        case ShapeKind::Cylinder:
+        case ShapeKind::Plate:
+        case ShapeKind::Rectangle:
+        case ShapeKind::Box:
+        case ShapeKind::Sphere: return true;
+    }
+    return false;
+}
+
+std::string_view shape_word(ShapeKind s) {
+    switch (s) {
+        case ShapeKind::Cylinder: return "cylinder";
+        case ShapeKind::Plate: return "plate";
+        case ShapeKind::Rectangle: return "rectangle";
+        case ShapeKind::Box: return "box";
+        case ShapeKind::Sphere: return "sphere";
+    }
+    return "?";
+}
+
+bool is_round(ShapeKind s) { return s == ShapeKind::Cylinder || s == ShapeKind::Plate || s == ShapeKind::Sphere; }
+
+// The interval a body occupies along an axis (before any node is placed).
+std::pair<double, double> extent(const BodySpec& b, GeometryKind g, int axis) {
+    const int dim = dimension_of(g);
+    const bool axial = axis == dim - 1;  // z
+    const double o = b.origin[static_cast<std::size_t>(axis)];
+    switch (b.shape) {
+        case ShapeKind::Cylinder:
+        case ShapeKind::Plate:
+            if (axial) return {o, o + b.length};
+            if (g == GeometryKind::Axisymmetric) return {0.0, b.radius};
+            return {o - b.radius, o + b.radius};
+        case ShapeKind::Sphere:
+            if (g == GeometryKind::Axisymmetric && axis == 0) return {0.0, b.radius};
+            return {o - b.radius, o + b.radius};
+        case ShapeKind::Rectangle:
+        case ShapeKind::Box: return {o, o + b.size[static_cast<std::size_t>(axis)]};
+    }
+    return {o, o};
+}
+
+// The lattice spacing along an axis.
+double spacing_along(const BodySpec& b, GeometryKind g, int axis) {
+    if (dimension_of(g) == 2 && axis == 1 && b.spacing_z > 0.0) return b.spacing_z;
+    return b.spacing;
+}
+
+void check_material(const materials::Material& m, std::size_t i) {
+    if (m.name.empty()) {
+        fail(fmt::format("{}: a material needs a name (bodies refer to it by name)", material_label(m, i)));
+    }
+    try {
+        materials::validate(m);
+    } catch (const std::exception& e) {
+        fail(e.what());  // names the material and the field already
+    }
+}
+
+void check_body(const Scene& scene, const BodySpec& b, std::size_t i) {
+    const GeometryKind g = scene.geometry;
+    const int dim = dimension_of(g);
+    const std::string label = body_label(b, i);
+
+    if (!known_shape(b.shape)) fail(fmt::format("{}.shape: unknown shape value {}", label, static_cast<int>(b.shape)));
+    if (b.shape == ShapeKind::Rectangle && dim == 3) {
+        fail(fmt::format("{}.shape: a rectangle is a 2D shape; a 3D scene takes cylinder, plate, box or sphere", label));
+    }
+    if (b.shape == ShapeKind::Box && dim == 2) {
+        fail(fmt::format("{}.shape: a box is a 3D shape; {} takes cylinder, plate, rectangle or sphere", label,
+                         g == GeometryKind::Axisymmetric ? "an axisymmetric scene" : "a plane-strain scene"));
+    }
+
+    bool known_material = false;
+    for (const auto& m : scene.materials) known_material = known_material || m.name == b.material;
+    if (!known_material) {
+        std::string names;
+        for (const auto& m : scene.materials) names += (names.empty() ? "" : ", ") + fmt::format("\"{}\"", m.name);
+        fail(fmt::format("{}.material: \"{}\" is not among the scene's materials ({})", label, b.material,
+                         names.empty() ? "none" : names));
+    }
+
+    for (int k = 0; k < dim; ++k) {
+        if (!finite(b.origin[static_cast<std::size_t>(k)])) fail(fmt::format("{}.origin[{}] must be finite", label, k));
+        if (!finite(b.velocity[static_cast<std::size_t>(k)])) fail(fmt::format("{}.velocity[{}] must be finite", label, k));
+    }
+    for (int k = 0; k < stress_components(dim); ++k) {
+        if (!finite(b.initial_stress[static_cast<std::size_t>(k)])) {
+            fail(fmt::format("{}.initial_stress[{}] must be finite", label, k));
+        }
+    }
+
+    // Sizes.
+    if (is_round(b.shape)) {
+        if (!(b.radius > 0.0 && finite(b.radius))) {
+            fail(fmt::format("{}.radius = {} must be a positive length (m)", label, b.radius));
+        }
+        if (b.shape != ShapeKind::Sphere && !(b.length > 0.0 && finite(b.length))) {
+            fail(fmt::format("{}.length = {} must be a positive length (m)", label, b.length));
+        }
+        if (g == GeometryKind::Axisymmetric && b.origin[0] != 0.0) {
+            fail(fmt::format("{}.origin: an axisymmetric {} lies on the axis, so its origin x must be 0 (is {} m)", label,
+                             shape_word(b.shape), b.origin[0]));
+        }
+    } else {
+        for (int k = 0; k < dim; ++k) {
+            const double s = b.size[static_cast<std::size_t>(k)];
+            if (!(s > 0.0 && finite(s))) {
+                fail(fmt::format("{}.size[{}] = {} must be a positive length (m)", label, k, s));
+            }
+        }
+        if (g == GeometryKind::Axisymmetric && b.origin[0] < 0.0) {
+            fail(fmt::format("{}.origin: an axisymmetric rectangle must lie at x >= 0 (x is the radius), origin x is {} m",
+                             label, b.origin[0]));
+        }
+    }
+
+    // Spacings, and at least two nodes across every dimension of the body.
+    if (!(b.spacing > 0.0 && finite(b.spacing))) {
+        fail(fmt::format("{}.spacing = {} must be a positive length (m)", label, b.spacing));
+    }
+    if (dim == 3 && b.spacing_z != 0.0) {
+        fail(fmt::format("{}.spacing_z applies to 2D scenes only (a 3D lattice has one spacing)", label));
+    }
+    if (!(b.spacing_z >= 0.0 && finite(b.spacing_z))) {
+        fail(fmt::format("{}.spacing_z = {} must be a positive length (m), or 0 for the same as spacing", label, b.spacing_z));
+    }
+    for (int k = 0; k < dim; ++k) {
+        const auto [lo, hi] = extent(b, g, k);
+        const double across = hi - lo;
+        const double d = spacing_along(b, g, k);
+        if (across < 2.0 * d * (1.0 - 1e-12)) {
+            const bool radial = g == GeometryKind::Axisymmetric && k == 0 && is_round(b.shape);
+            fail(fmt::format("{}: spacing {} m puts fewer than 2 nodes across its {} ({} m along {}); use a spacing of at "
+                             "most {} m",
+                             label, d, radial ? "radius" : "extent", across, axis_letter(k, dim), across / 2.0));
+        }
+    }
+
+    if (b.lattice_neighbours != 0) {
+        const int n = b.lattice_neighbours;
+        const bool valid = dim == 2 ? (n == 4 || n == 8) : (n == 6 || n == 18 || n == 26);
+        if (!valid) {
+            fail(fmt::format("{}.lattice_neighbours = {} is not {} (or 0 for the default)", label, n,
+                             dim == 2 ? "4 or 8" : "6, 18 or 26"));
+        }
+    }
+    if (b.connectivity && !(*b.connectivity == ConnectivityMode::Fixed || *b.connectivity == ConnectivityMode::Variable ||
+                            *b.connectivity == ConnectivityMode::Automatic)) {
+        fail(fmt::format("{}.connectivity: unknown connectivity mode", label));
+    }
+}
+
+void check_plane(const Scene& scene, const PlaneSpec& p, std::size_t i) {
+    const GeometryKind g = scene.geometry;
+    const int dim = dimension_of(g);
+    const std::string label = plane_label(p, i);
+    if (p.kind != PlaneKind::Rigid && p.kind != PlaneKind::Symmetry) fail(fmt::format("{}.kind: unknown plane kind", label));
+    if (p.axis < 0 || p.axis >= dim) {
+        fail(fmt::format("{}.axis = {} is not a direction of {} scene ({})", label, p.axis,
+                         g == GeometryKind::Axisymmetric ? "an axisymmetric" : dim == 2 ? "a plane-strain" : "a 3D",
+                         dim == 2 ? "0 = x, 1 = z" : "0 = x, 1 = y, 2 = z"));
+    }
+    if (p.side != 1 && p.side != -1) {
+        fail(fmt::format("{}.side = {} must be +1 (bodies above the plane) or -1 (below)", label, p.side));
+    }
+    if (!finite(p.position)) fail(fmt::format("{}.position must be finite", label));
+    const char letter = axis_letter(p.axis, dim);
+    if (g == GeometryKind::Axisymmetric && p.axis == 0 && p.position <= 0.0) {
+        fail(fmt::format("{}: a plane normal to x must lie at x > 0 in an axisymmetric scene (the axis x = 0 is a "
+                         "symmetry plane already); it is at x = {} m",
+                         label, p.position));
+    }
+    for (std::size_t k = 0; k < scene.bodies.size(); ++k) {
+        const BodySpec& b = scene.bodies[k];
+        const auto [lo, hi] = extent(b, g, p.axis);
+        const double tolerance = 1e-9 * std::max(b.spacing, std::abs(p.position));
+        if (p.side > 0 && lo < p.position - tolerance) {
+            fail(fmt::format("{} at {} = {} m keeps bodies above it (side +1), but {} is on the wrong side: it reaches down "
+                             "to {} = {} m",
+                             label, letter, p.position, body_label(b, k), letter, lo));
+        }
+        if (p.side < 0 && hi > p.position + tolerance) {
+            fail(fmt::format("{} at {} = {} m keeps bodies below it (side -1), but {} is on the wrong side: it reaches up "
+                             "to {} = {} m",
+                             label, letter, p.position, body_label(b, k), letter, hi));
+        }
+    }
+}
+
+void check_solver(const SolverOptions& s) {
+    if (s.connectivity != ConnectivityMode::Fixed && s.connectivity != ConnectivityMode::Variable &&
+        s.connectivity != ConnectivityMode::Automatic) {
+        fail("solver.connectivity: unknown connectivity mode");
+    }
+    if (!(s.switch_plastic_strain > 0.0 && finite(s.switch_plastic_strain))) {
+        fail(fmt::format("solver.switch_plastic_strain = {} must be a positive plastic strain", s.switch_plastic_strain));
+    }
+    if (!(s.influence_distance >= min_influence_distance && s.influence_distance <= max_influence_distance)) {
+        fail(fmt::format("solver.influence_distance = {} is outside the method's range [{}, {}]", s.influence_distance,
+                         min_influence_distance, max_influence_distance));
+    }
+    if (s.weight != WeightKind::Gpa && s.weight != WeightKind::SphNsf) fail("solver.weight: unknown weight kind");
+    if (s.viscosity != ViscosityKind::None && s.viscosity != ViscosityKind::Nodal && s.viscosity != ViscosityKind::Bond) {
+        fail("solver.viscosity: unknown viscosity kind");
+    }
+    if (!(s.viscosity_linear >= 0.0 && finite(s.viscosity_linear))) {
+        fail(fmt::format("solver.viscosity_linear = {} must be a finite number >= 0", s.viscosity_linear));
+    }
+    if (!(s.viscosity_quadratic >= 0.0 && finite(s.viscosity_quadratic))) {
+        fail(fmt::format("solver.viscosity_quadratic = {} must be a finite number >= 0", s.viscosity_quadratic));
+    }
+    if (!(s.bond_viscosity_eps0 > 0.0 && finite(s.bond_viscosity_eps0))) {
+        fail(fmt::format("solver.bond_viscosity_eps0 = {} must be a positive number", s.bond_viscosity_eps0));
+    }
+    if (s.smoothing != SmoothingMode::Off && s.smoothing != SmoothingMode::Everywhere &&
+        s.smoothing != SmoothingMode::Tension) {
+        fail("solver.smoothing: unknown smoothing mode");
+    }
+    if (!(s.smoothing_coefficient >= 0.0 && s.smoothing_coefficient < 1.0)) {
+        fail(fmt::format("solver.smoothing_coefficient = {} is outside [0, 1)", s.smoothing_coefficient));
+    }
+    if (!(s.cfl > 0.0 && s.cfl <= 1.0)) fail(fmt::format("solver.cfl = {} is outside (0, 1]", s.cfl));
+    if (!(s.alpha_limit >= 0.0 && finite(s.alpha_limit))) {
+        fail(fmt::format("solver.alpha_limit = {} must be a finite number >= 0 (0 = no limit)", s.alpha_limit));
+    }
+    if (!(s.max_time_step > 0.0)) {
+        fail(fmt::format("solver.max_time_step = {} must be a positive time (s), or infinity for no limit", s.max_time_step));
+    }
+    if (!(s.time_step_growth >= 1.0 && finite(s.time_step_growth))) {
+        fail(fmt::format("solver.time_step_growth = {} must be a finite ratio >= 1", s.time_step_growth));
+    }
+    if (s.scatter != ScatterScheme::Slabs && s.scatter != ScatterScheme::Cells && s.scatter != ScatterScheme::Graph &&
+        s.scatter != ScatterScheme::Serial) {
+        fail("solver.scatter: unknown scatter scheme");
+    }
+}
+
+void check_stop(const StopCriteria& s) {
+    if (!(s.end_time >= 0.0 && finite(s.end_time))) {
+        fail(fmt::format("stop.end_time = {} must be a finite time >= 0 (s)", s.end_time));
+    }
+    if (!(s.kinetic_energy_fraction >= 0.0 && s.kinetic_energy_fraction < 1.0)) {
+        fail(fmt::format("stop.kinetic_energy_fraction = {} is outside [0, 1)", s.kinetic_energy_fraction));
+    }
+    if (s.end_time == 0.0 && s.kinetic_energy_fraction == 0.0 && s.max_steps == 0) {
+        fail("stop: no end condition; set stop.end_time, stop.kinetic_energy_fraction or stop.max_steps");
+    }
+}
+
+void check_output(const OutputOptions& o) {
+    if (!(o.snapshot_interval >= 0.0 && finite(o.snapshot_interval))) {
+        fail(fmt::format("output.snapshot_interval = {} must be a finite time >= 0 (s)", o.snapshot_interval));
+    }
+    if (o.history_every == 0) fail("output.history_every must be at least 1 (steps between history rows)");
+}
+
+}  // namespace
+
+void validate_scene(const Scene& scene) {
+    const GeometryKind g = scene.geometry;
+    if (g != GeometryKind::Axisymmetric && g != GeometryKind::PlaneStrain && g != GeometryKind::ThreeD) {
+        fail("geometry: unknown geometry");
+    }
+
+    for (std::size_t i = 0; i < scene.materials.size(); ++i) {
+        check_material(scene.materials[i], i);
+        for (std::size_t j = 0; j < i; ++j) {
+            if (same_name(scene.materials[j].name, scene.materials[i].name)) {
+                fail(fmt::format("{}: the name is already used by {}", material_label(scene.materials[i], i),
+                                 material_label(scene.materials[j], j)));
+            }
+        }
+    }
+
+    if (scene.bodies.empty()) fail("body: a scene needs at least one body");
+    for (std::size_t i = 0; i < scene.bodies.size(); ++i) {
+        check_body(scene, scene.bodies[i], i);
+        for (std::size_t j = 0; j < i; ++j) {
+            if (!scene.bodies[i].name.empty() && scene.bodies[j].name == scene.bodies[i].name) {
+                fail(fmt::format("{}: the name is already used by body[{}]", body_label(scene.bodies[i], i), j));
+            }
+        }
+    }
+
+    for (std::size_t i = 0; i < scene.planes.size(); ++i) {
+        check_plane(scene, scene.planes[i], i);
+        for (std::size_t j = 0; j < i; ++j) {
+            if (!scene.planes[i].name.empty() && scene.planes[j].name == scene.planes[i].name) {
+                fail(fmt::format("{}: the name is already used by plane[{}]", plane_label(scene.planes[i], i), j));
+            }
+        }
+    }
+
+    check_solver(scene.solver);
+    check_stop(scene.stop);
+    check_output(scene.output);
+
+    for (const auto& [key, value] : scene.reference) {
+        if (!finite(value)) fail(fmt::format("reference.{} = {} must be finite", key, value));
+    }
+}
 
 }  // namespace gpa

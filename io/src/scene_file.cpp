@@ -1,0 +1,474 @@
+#include "gpa/io/scene_file.hpp"
+
+#include <array>
+#include <cstdint>
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <optional>
+#include <sstream>
+#include <system_error>
+
+#include <fmt/format.h>
+
+#include "gpa/io/material_library.hpp"
+#include "material_table.hpp"
+#include "toml_reading.hpp"
+
+namespace gpa::io {
+
+namespace {
+
+using namespace detail;
+using D = Dimension;
+
+constexpr std::uintmax_t max_scene_file_bytes = 16u << 20;
+
+const std::vector<std::string_view> scene_keys{
+    "name", "description", "geometry", "material", "body", "plane", "solver", "stop", "output", "reference",
+};
+const std::vector<std::string_view> body_keys{
+    "name",    "shape",     "material", "origin",         "size",         "radius",            "diameter",
+    "length",  "spacing",   "spacing_z", "velocity",      "initial_stress", "connectivity",    "lattice_neighbours",
+};
+const std::vector<std::string_view> plane_keys{"name", "kind", "axis", "position", "side", "lift_off"};
+const std::vector<std::string_view> solver_keys{
+    "connectivity", "switch_plastic_strain", "influence_distance", "weight",          "viscosity",
+    "viscosity_linear", "viscosity_quadratic", "bond_viscosity_eps0", "smoothing",     "smoothing_coefficient",
+    "cfl",          "alpha_limit",           "max_time_step",      "time_step_growth", "failure",
+    "scatter",      "reorder_interval",
+};
+const std::vector<std::string_view> stop_keys{"end_time", "kinetic_energy_fraction", "max_steps"};
+const std::vector<std::string_view> output_keys{"snapshots", "snapshot_interval", "history_every"};
+
+const Choices<ConnectivityMode> connectivity_words{
+    {"fixed", ConnectivityMode::Fixed}, {"variable", ConnectivityMode::Variable}, {"automatic", ConnectivityMode::Automatic}};
+
+// --- the scene's materials ----------------------------------------------------------------
+
+// The materials a scene defines, plus library materials as bodies name them.
+class SceneMaterials {
+public:
+    explicit SceneMaterials(std::vector<materials::Material> defined) : materials_(std::move(defined)) {}
+
+    // The scene's name for `name` (letter case ignored), adding a library material on first use.
+    std::optional<std::string> resolve(std::string_view name) {
+        for (const auto& m : materials_) {
+            if (same_name(m.name, name)) return m.name;
+        }
+        if (const auto* m = find_builtin_material(name)) {
+            materials_.push_back(*m);
+            return m->name;
+        }
+        return std::nullopt;
+    }
+
+    std::string known_names() const {
+        std::string names;
+        for (const auto& m : materials_) names += (names.empty() ? "" : ", ") + m.name;
+        for (const auto& m : builtin_materials()) {
+            bool listed = false;
+            for (const auto& own : materials_) listed = listed || same_name(own.name, m.name);
+            if (!listed) names += (names.empty() ? "" : ", ") + m.name;
+        }
+        return names;
+    }
+
+    std::vector<materials::Material> take() { return std::move(materials_); }
+
+private:
+    std::vector<materials::Material> materials_;
+};
+
+// --- helpers ---------------------------------------------------------------------------------
+
+std::string labelled_path(std::string_view kind, const toml::table& table, std::size_t index) {
+    if (const toml::node* name = table.get("name")) {
+        if (const auto* s = name->as_string()) return fmt::format("{} {} ({}[{}])", kind, in_quotes(s->get()), kind, index);
+    }
+    return fmt::format("{}[{}]", kind, index);
+}
+
+// The tables of an array-of-tables key ([[body]], [[plane]]).
+std::vector<const toml::table*> tables_of(const TableReader& top, std::string_view key) {
+    std::vector<const toml::table*> out;
+    const toml::node* node = top.find(key);
+    if (!node) return out;
+    const auto* array = node->as_array();
+    if (!array) {
+        top.fail_at(key, fmt::format("expected [[{}]] tables (an array of tables), got {}: write [[{}]] above each {}",
+                                     key, type_name(*node), key, key));
+    }
+    for (std::size_t i = 0; i < array->size(); ++i) {
+        const toml::node& element = (*array)[i];
+        const auto* table = element.as_table();
+        if (!table) {
+            top.reporter().fail(line_of(element), fmt::format("{}[{}]", key, i),
+                                fmt::format("expected a table, got {}", type_name(element)));
+        }
+        out.push_back(table);
+    }
+    return out;
+}
+
+// A sub-table such as [solver]; an absent one reads as empty.
+const toml::table& sub_table(const TableReader& top, std::string_view key, const toml::table& empty) {
+    const toml::node* node = top.find(key);
+    if (!node) return empty;
+    const auto* table = node->as_table();
+    if (!table) top.fail_at(key, fmt::format("expected a table ([{}]), got {}", key, type_name(*node)));
+    return *table;
+}
+
+std::string_view scene_phrase(GeometryKind g) {
+    switch (g) {
+        case GeometryKind::Axisymmetric: return "an axisymmetric scene";
+        case GeometryKind::PlaneStrain: return "a plane-strain scene";
+        case GeometryKind::ThreeD: break;
+    }
+    return "a 3D scene";
+}
+
+std::string_view components_of(int dim) { return dim == 2 ? "[x, z]" : "[x, y, z]"; }
+
+std::array<double, 3> to_vector3(const std::vector<double>& v) {
+    std::array<double, 3> out{0, 0, 0};
+    for (std::size_t i = 0; i < v.size() && i < 3; ++i) out[i] = v[i];
+    return out;
+}
+
+bool is_round(ShapeKind s) { return s == ShapeKind::Cylinder || s == ShapeKind::Plate || s == ShapeKind::Sphere; }
+
+std::string_view shape_word(ShapeKind s) {
+    switch (s) {
+        case ShapeKind::Cylinder: return "cylinder";
+        case ShapeKind::Plate: return "plate";
+        case ShapeKind::Rectangle: return "rectangle";
+        case ShapeKind::Box: return "box";
+        case ShapeKind::Sphere: return "sphere";
+    }
+    return "?";
+}
+
+// --- bodies ----------------------------------------------------------------------------------
+
+std::array<double, 6> read_initial_stress(const TableReader& body, GeometryKind geometry) {
+    const int dim = dimension_of(geometry);
+    const std::vector<std::string_view> names =
+        dim == 3 ? std::vector<std::string_view>{"xx", "yy", "zz", "yz", "xz", "xy"}
+        : geometry == GeometryKind::Axisymmetric ? std::vector<std::string_view>{"xx", "zz", "xz", "tt"}
+                                                 : std::vector<std::string_view>{"xx", "zz", "xz", "yy"};
+    std::string order = "[";
+    for (std::size_t i = 0; i < names.size(); ++i) order += (i ? ", " : "") + std::string(names[i]);
+    order += "]";
+
+    std::array<double, 6> stress{0, 0, 0, 0, 0, 0};
+    const toml::node* node = body.find("initial_stress");
+    if (const auto* table = node->as_table()) {
+        const TableReader t(body.reporter(), *table, body.key_path("initial_stress"),
+                            fmt::format("the initial stress in {}", scene_phrase(geometry)), names);
+        for (std::size_t i = 0; i < names.size(); ++i) {
+            if (const auto v = t.quantity(names[i], D::Pressure)) stress[i] = *v;
+        }
+        return stress;
+    }
+    if (!node->as_array()) {
+        body.fail_at("initial_stress", fmt::format("expected a table of stress components ({} = ...) or an array {}, got {}",
+                                                   names[0], order, type_name(*node)));
+    }
+    const auto values = body.quantities("initial_stress", D::Pressure, names.size(), Limit::Any, order);
+    for (std::size_t i = 0; i < values->size(); ++i) stress[i] = (*values)[i];
+    return stress;
+}
+
+BodySpec read_body(const Reporter& reporter, const toml::table& table, std::size_t index, GeometryKind geometry,
+                   SceneMaterials& scene_materials) {
+    const TableReader r(reporter, table, labelled_path("body", table, index), "a body", body_keys);
+    const int dim = dimension_of(geometry);
+    BodySpec b;
+    b.name = r.string("name").value_or(fmt::format("body{}", index));
+    if (b.name.empty()) r.fail_at("name", "a body's name must not be empty (leave the key out for \"body<index>\")");
+
+    const auto shape = r.choice<ShapeKind>("shape", {{"cylinder", ShapeKind::Cylinder},
+                                                     {"plate", ShapeKind::Plate},
+                                                     {"rectangle", ShapeKind::Rectangle},
+                                                     {"box", ShapeKind::Box},
+                                                     {"sphere", ShapeKind::Sphere}});
+    if (!shape) r.fail_missing("shape", "cylinder, plate, rectangle, box or sphere");
+    b.shape = *shape;
+    if (b.shape == ShapeKind::Box && dim == 2) {
+        r.fail_at("shape", fmt::format("\"box\" is a 3D shape; {} takes cylinder, plate, rectangle or sphere",
+                                       scene_phrase(geometry)));
+    }
+    if (b.shape == ShapeKind::Rectangle && dim == 3) {
+        r.fail_at("shape", "\"rectangle\" is a 2D shape; a 3D scene takes cylinder, plate, box or sphere");
+    }
+
+    const std::string material = r.required_string("material", "a library material or a scene [[material]] name");
+    if (const auto resolved = scene_materials.resolve(material)) {
+        b.material = *resolved;
+    } else {
+        r.fail_at("material", fmt::format("unknown material {}; known materials: {} (or define it in a [[material]] table)",
+                                          in_quotes(material), scene_materials.known_names()));
+    }
+
+    const std::string_view components = components_of(dim);
+    if (const auto origin = r.quantities("origin", D::Length, static_cast<std::size_t>(dim), Limit::Any, components)) {
+        b.origin = to_vector3(*origin);
+    }
+
+    const std::string_view shape_name = shape_word(b.shape);
+    if (is_round(b.shape)) {
+        if (r.has("radius") && r.has("diameter")) r.fail_at("diameter", "give radius or diameter, not both");
+        if (const auto radius = r.quantity("radius", D::Length, Limit::Positive)) {
+            b.radius = *radius;
+        } else if (const auto diameter = r.quantity("diameter", D::Length, Limit::Positive)) {
+            b.radius = 0.5 * *diameter;
+        } else {
+            r.fail_missing("radius", fmt::format("or diameter: the size of the {}", shape_name));
+        }
+        if (r.has("size")) {
+            r.fail_at("size", fmt::format("does not apply to a {} (give radius{})", shape_name,
+                                          b.shape == ShapeKind::Sphere ? "" : " and length"));
+        }
+    } else {
+        for (const std::string_view key : {"radius", "diameter", "length"}) {
+            if (r.has(key)) r.fail_at(key, fmt::format("does not apply to a {} (give size = {})", shape_name, components));
+        }
+        const auto size = r.quantities("size", D::Length, static_cast<std::size_t>(dim), Limit::Positive, components);
+        if (!size) r.fail_missing("size", fmt::format("the {}'s edge lengths {}", shape_name, components));
+        b.size = to_vector3(*size);
+    }
+    if (b.shape == ShapeKind::Cylinder || b.shape == ShapeKind::Plate) {
+        const auto length = r.quantity("length", D::Length, Limit::Positive);
+        if (!length) r.fail_missing("length", fmt::format("the {}'s length along z", shape_name));
+        b.length = *length;
+    } else if (b.shape == ShapeKind::Sphere && r.has("length")) {
+        r.fail_at("length", "does not apply to a sphere (give radius or diameter)");
+    }
+
+    b.spacing = r.required_quantity("spacing", D::Length, Limit::Positive);
+    if (r.has("spacing_z")) {
+        if (dim == 3) r.fail_at("spacing_z", "applies to 2D scenes only: a 3D lattice has one spacing in every direction");
+        b.spacing_z = *r.quantity("spacing_z", D::Length, Limit::Positive);
+    }
+    if (const auto velocity = r.quantities("velocity", D::Velocity, static_cast<std::size_t>(dim), Limit::Any, components)) {
+        b.velocity = to_vector3(*velocity);
+    }
+    if (r.has("initial_stress")) b.initial_stress = read_initial_stress(r, geometry);
+    b.connectivity = r.choice<ConnectivityMode>("connectivity", connectivity_words);
+    if (const auto n = r.whole_number("lattice_neighbours", 0, 26)) b.lattice_neighbours = static_cast<int>(*n);
+    return b;
+}
+
+// --- planes ----------------------------------------------------------------------------------
+
+PlaneSpec read_plane(const Reporter& reporter, const toml::table& table, std::size_t index, GeometryKind geometry) {
+    const TableReader r(reporter, table, labelled_path("plane", table, index), "a plane", plane_keys);
+    const int dim = dimension_of(geometry);
+    PlaneSpec p;
+    p.name = r.string("name").value_or(fmt::format("plane{}", index));
+    if (p.name.empty()) r.fail_at("name", "a plane's name must not be empty (leave the key out for \"plane<index>\")");
+
+    const auto kind = r.choice<PlaneKind>("kind", {{"rigid", PlaneKind::Rigid}, {"symmetry", PlaneKind::Symmetry}});
+    if (!kind) r.fail_missing("kind", "rigid or symmetry");
+    p.kind = *kind;
+
+    const auto axis = dim == 2 ? r.choice<int>("axis", {{"x", 0}, {"z", 1}})
+                               : r.choice<int>("axis", {{"x", 0}, {"y", 1}, {"z", 2}});
+    if (!axis) r.fail_missing("axis", dim == 2 ? "the plane's normal: x or z" : "the plane's normal: x, y or z");
+    p.axis = *axis;
+    p.position = r.required_quantity("position", D::Length);
+
+    if (const toml::node* side = r.find("side")) {
+        if (side->is_string()) {
+            p.side = *r.choice<int>("side", {{"above", +1}, {"below", -1}});
+        } else if (const auto* number = side->as_integer(); number && (number->get() == 1 || number->get() == -1)) {
+            p.side = static_cast<int>(number->get());
+        } else {
+            r.fail_at("side", fmt::format("{} is not \"above\", \"below\", 1 or -1 (the side of the plane the bodies are on)",
+                                          as_written(*side)));
+        }
+    }
+    if (const auto lift_off = r.boolean("lift_off")) {
+        if (p.kind == PlaneKind::Symmetry) {
+            r.fail_at("lift_off", "applies to rigid planes only (a symmetry plane always holds its nodes)");
+        }
+        p.lift_off = *lift_off;
+    }
+    return p;
+}
+
+// --- options -------------------------------------------------------------------------------
+
+SolverOptions read_solver(const Reporter& reporter, const toml::table& table) {
+    const TableReader r(reporter, table, "solver", "[solver]", solver_keys);
+    SolverOptions s;
+    if (const auto v = r.choice<ConnectivityMode>("connectivity", connectivity_words)) s.connectivity = *v;
+    if (const auto v = r.quantity("switch_plastic_strain", D::Dimensionless)) s.switch_plastic_strain = *v;
+    if (const auto v = r.quantity("influence_distance", D::Dimensionless)) s.influence_distance = *v;
+    if (const auto v = r.choice<WeightKind>("weight", {{"gpa", WeightKind::Gpa}, {"sph-nsf", WeightKind::SphNsf}})) {
+        s.weight = *v;
+    }
+    if (const auto v = r.choice<ViscosityKind>(
+            "viscosity", {{"none", ViscosityKind::None}, {"nodal", ViscosityKind::Nodal}, {"bond", ViscosityKind::Bond}})) {
+        s.viscosity = *v;
+    }
+    if (const auto v = r.quantity("viscosity_linear", D::Dimensionless)) s.viscosity_linear = *v;
+    if (const auto v = r.quantity("viscosity_quadratic", D::Dimensionless)) s.viscosity_quadratic = *v;
+    if (const auto v = r.quantity("bond_viscosity_eps0", D::Dimensionless)) s.bond_viscosity_eps0 = *v;
+    if (const auto v = r.choice<SmoothingMode>("smoothing", {{"off", SmoothingMode::Off},
+                                                             {"everywhere", SmoothingMode::Everywhere},
+                                                             {"tension", SmoothingMode::Tension}})) {
+        s.smoothing = *v;
+    }
+    if (const auto v = r.quantity("smoothing_coefficient", D::Dimensionless)) s.smoothing_coefficient = *v;
+    if (const auto v = r.quantity("cfl", D::Dimensionless)) s.cfl = *v;
+    if (const auto v = r.quantity("alpha_limit", D::Dimensionless)) s.alpha_limit = *v;
+    if (const auto v = r.quantity("max_time_step", D::Time, Limit::PositiveOrInfinite)) s.max_time_step = *v;
+    if (const auto v = r.quantity("time_step_growth", D::Dimensionless)) s.time_step_growth = *v;
+    if (const auto v = r.boolean("failure")) s.failure = *v;
+    if (const auto v = r.choice<ScatterScheme>("scatter", {{"slabs", ScatterScheme::Slabs},
+                                                           {"cells", ScatterScheme::Cells},
+                                                           {"graph", ScatterScheme::Graph},
+                                                           {"serial", ScatterScheme::Serial}})) {
+        s.scatter = *v;
+    }
+    if (const auto v = r.whole_number("reorder_interval", 0, std::numeric_limits<long long>::max())) {
+        s.reorder_interval = static_cast<std::size_t>(*v);
+    }
+    return s;
+}
+
+StopCriteria read_stop(const Reporter& reporter, const toml::table& table) {
+    const TableReader r(reporter, table, "stop", "[stop]", stop_keys);
+    StopCriteria s;
+    if (const auto v = r.quantity("end_time", D::Time, Limit::NonNegative)) s.end_time = *v;
+    if (const auto v = r.quantity("kinetic_energy_fraction", D::Dimensionless, Limit::NonNegative)) {
+        s.kinetic_energy_fraction = *v;
+    }
+    if (const auto v = r.whole_number("max_steps", 0, std::numeric_limits<long long>::max())) {
+        s.max_steps = static_cast<std::size_t>(*v);
+    }
+    return s;
+}
+
+OutputOptions read_output(const Reporter& reporter, const toml::table& table) {
+    const TableReader r(reporter, table, "output", "[output]", output_keys);
+    OutputOptions o;
+    if (const auto v = r.whole_number("snapshots", 0, std::numeric_limits<long long>::max())) {
+        o.snapshots = static_cast<std::size_t>(*v);
+    }
+    if (const auto v = r.quantity("snapshot_interval", D::Time, Limit::NonNegative)) o.snapshot_interval = *v;
+    if (const auto v = r.whole_number("history_every", 1, std::numeric_limits<long long>::max())) {
+        o.history_every = static_cast<std::size_t>(*v);
+    }
+    return o;
+}
+
+// [reference]: free-form keys; each value a number or a quantity of any dimension, kept in SI.
+void read_reference(const Reporter& reporter, const toml::table& table, Scene& scene) {
+    for (const auto& [key, node] : table) {
+        const std::string path = fmt::format("reference.{}", printable(key.str()));
+        const std::size_t line = line_of(node);
+        if (key.str() == "source") {
+            const auto* s = node.as_string();
+            if (!s) reporter.fail(line, path, fmt::format("expected a string, got {}", type_name(node)));
+            scene.reference_source = s->get();
+            continue;
+        }
+        double value = 0.0;
+        if (const auto* i = node.as_integer()) {
+            value = static_cast<double>(i->get());
+        } else if (const auto* f = node.as_floating_point()) {
+            value = f->get();
+            if (!std::isfinite(value)) reporter.fail(line, path, fmt::format("{} is not allowed: a reference value must be finite", as_written(node)));
+        } else if (const auto* s = node.as_string()) {
+            try {
+                value = parse_any_quantity(s->get()).value;
+            } catch (const UnitError& e) {
+                reporter.fail(line, path, e.what());
+            }
+        } else {
+            reporter.fail(line, path,
+                          fmt::format("expected a number or a quantity such as \"16.21 mm\" (or `source = \"...\"`), got {}",
+                                      type_name(node)));
+        }
+        scene.reference[std::string(key.str())] = value;
+    }
+}
+
+Scene read_scene(std::string_view text, const Reporter& reporter) {
+    check_text(text, reporter);
+    const toml::table root = parse_toml(text, reporter);
+    if (root.empty()) {
+        reporter.fail(0, "", "the file is empty: a scene needs at least `geometry`, one [[body]] and a [stop] table");
+    }
+    const TableReader top(reporter, root, "", "a scene", scene_keys);
+    Scene scene;
+    scene.name = top.string("name").value_or(std::filesystem::path(reporter.file()).stem().string());
+    scene.description = top.string("description").value_or("");
+
+    const auto geometry = top.choice<GeometryKind>("geometry", {{"axisymmetric", GeometryKind::Axisymmetric},
+                                                                {"plane-strain", GeometryKind::PlaneStrain},
+                                                                {"3d", GeometryKind::ThreeD}});
+    if (!geometry) top.fail_missing("geometry", "\"axisymmetric\", \"plane-strain\" or \"3d\"");
+    scene.geometry = *geometry;
+
+    SceneMaterials scene_materials(
+        read_materials(reporter, top.find("material"), OutsideMaterials{find_builtin_material, builtin_material_names}));
+
+    const auto body_tables = tables_of(top, "body");
+    if (body_tables.empty()) top.fail_missing("body", "at least one [[body]] table");
+    for (std::size_t i = 0; i < body_tables.size(); ++i) {
+        scene.bodies.push_back(read_body(reporter, *body_tables[i], i, scene.geometry, scene_materials));
+    }
+    const auto plane_tables = tables_of(top, "plane");
+    for (std::size_t i = 0; i < plane_tables.size(); ++i) {
+        scene.planes.push_back(read_plane(reporter, *plane_tables[i], i, scene.geometry));
+    }
+    scene.materials = scene_materials.take();
+
+    const toml::table empty;
+    scene.solver = read_solver(reporter, sub_table(top, "solver", empty));
+    scene.stop = read_stop(reporter, sub_table(top, "stop", empty));
+    scene.output = read_output(reporter, sub_table(top, "output", empty));
+    read_reference(reporter, sub_table(top, "reference", empty), scene);
+    return scene;
+}
+
+}  // namespace
+
+Scene parse_scene(std::string_view text, const std::string& file_name_for_messages) {
+    const Reporter reporter(file_name_for_messages);
+    Scene scene = read_scene(text, reporter);
+    // The scene-level rules (shapes for the geometry, planes, spacings, option ranges, materials)
+    // are the engine's, the same for a Scene built in code.
+    try {
+        validate_scene(scene);
+    } catch (const InputError& e) {
+        reporter.fail(0, "", e.what());
+    }
+    return scene;
+}
+
+Scene load_scene(const std::filesystem::path& file) {
+    const std::string name = file.string();
+    const Reporter reporter(name);
+    std::error_code ec;
+    const auto status = std::filesystem::status(file, ec);
+    if (ec || !std::filesystem::exists(status)) reporter.fail(0, "", "cannot read the scene file: it does not exist");
+    if (std::filesystem::is_directory(status)) reporter.fail(0, "", "cannot read the scene file: it is a directory");
+    const auto size = std::filesystem::file_size(file, ec);
+    if (!ec && size > max_scene_file_bytes) {
+        reporter.fail(0, "", fmt::format("is {} bytes long: too large for a scene file (at most {})", size, max_scene_file_bytes));
+    }
+    std::ifstream in(file, std::ios::binary);
+    if (!in) reporter.fail(0, "", "cannot open the scene file for reading");
+    std::ostringstream text;
+    text << in.rdbuf();
+    if (in.bad()) reporter.fail(0, "", "reading the scene file failed");
+    return parse_scene(text.str(), name);
+}
+
+}  // namespace gpa::io

@@ -1,0 +1,387 @@
+#include "toml_reading.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+
+#include <fmt/format.h>
+
+#include "gpa/io/scene_file.hpp"
+
+namespace gpa::io::detail {
+
+namespace {
+
+using D = Dimension;
+
+char lower(char c) { return (c >= 'A' && c <= 'Z') ? static_cast<char>(c - 'A' + 'a') : c; }
+
+// Edit distance with adjacent transpositions counted as one edit ("raduis" -> "radius": 1).
+std::size_t edit_distance(std::string_view a, std::string_view b) {
+    const std::size_t n = a.size(), m = b.size();
+    std::vector<std::vector<std::size_t>> d(n + 1, std::vector<std::size_t>(m + 1, 0));
+    for (std::size_t i = 0; i <= n; ++i) d[i][0] = i;
+    for (std::size_t j = 0; j <= m; ++j) d[0][j] = j;
+    for (std::size_t i = 1; i <= n; ++i) {
+        for (std::size_t j = 1; j <= m; ++j) {
+            const std::size_t cost = lower(a[i - 1]) == lower(b[j - 1]) ? 0 : 1;
+            d[i][j] = std::min({d[i - 1][j] + 1, d[i][j - 1] + 1, d[i - 1][j - 1] + cost});
+            if (i > 1 && j > 1 && lower(a[i - 1]) == lower(b[j - 2]) && lower(a[i - 2]) == lower(b[j - 1])) {
+                d[i][j] = std::min(d[i][j], d[i - 2][j - 2] + 1);
+            }
+        }
+    }
+    return d[n][m];
+}
+
+std::string join_quoted(const std::vector<std::string_view>& words) {
+    std::string out;
+    for (std::size_t i = 0; i < words.size(); ++i) {
+        if (i > 0) out += i + 1 == words.size() ? " or " : ", ";
+        out += fmt::format("\"{}\"", words[i]);
+    }
+    return out;
+}
+
+std::string join(const std::vector<std::string_view>& words) {
+    std::string out;
+    for (std::size_t i = 0; i < words.size(); ++i) {
+        if (i > 0) out += ", ";
+        out += words[i];
+    }
+    return out;
+}
+
+std::string_view example_of(Dimension d) {
+    switch (d) {
+        case Dimension::Dimensionless: return "0.5";
+        case Dimension::Length: return "\"15.2 mm\"";
+        case Dimension::Time: return "\"40 us\"";
+        case Dimension::Velocity: return "\"305 m/s\"";
+        case Dimension::Density: return "\"7.89 g/cc\"";
+        case Dimension::Pressure: return "\"175 MPa\"";
+        case Dimension::Temperature: return "\"294 K\"";
+        case Dimension::SpecificHeat: return "\"452 J/kg/K\"";
+        case Dimension::SpecificEnergy: return "\"1 kJ/kg\"";
+        case Dimension::StrainRate: return "\"1 1/s\"";
+    }
+    return "";
+}
+
+std::string expected_quantity(Dimension d) {
+    if (d == Dimension::Dimensionless) return "a number";
+    return fmt::format("a {} (a number in {} or a string such as {})", name_of(d), si_unit_of(d), example_of(d));
+}
+
+std::string noun_of(Dimension d) { return d == Dimension::Dimensionless ? "number" : std::string(name_of(d)); }
+
+}  // namespace
+
+void Reporter::fail(std::size_t line, std::string_view key, std::string_view message) const {
+    std::string text = file_;
+    if (line > 0) text += fmt::format(":{}", line);
+    text += ": ";
+    if (!key.empty()) {
+        text += key;
+        text += ": ";
+    }
+    text += message;
+    throw SceneError(printable(text, std::numeric_limits<std::size_t>::max()));
+}
+
+std::string printable(std::string_view text, std::size_t max_length) {
+    std::string out;
+    std::size_t i = 0;
+    for (; i < text.size() && out.size() < max_length; ++i) {
+        const auto c = static_cast<unsigned char>(text[i]);
+        if (c == '\n') {
+            out += "\\n";
+        } else if (c == '\r') {
+            out += "\\r";
+        } else if (c == '\t') {
+            out += "\\t";
+        } else if (c < 0x20 || c == 0x7F) {
+            out += fmt::format("\\x{:02X}", static_cast<unsigned>(c));
+        } else {
+            out += static_cast<char>(c);
+        }
+    }
+    if (i < text.size()) {
+        // Do not cut a UTF-8 sequence in two.
+        while (!out.empty() && (static_cast<unsigned char>(out.back()) & 0xC0) == 0x80) out.pop_back();
+        if (!out.empty() && static_cast<unsigned char>(out.back()) >= 0xC0) out.pop_back();
+        out += "...";
+    }
+    return out;
+}
+
+std::string in_quotes(std::string_view text) { return fmt::format("\"{}\"", printable(text)); }
+
+void check_text(std::string_view text, const Reporter& reporter) {
+    std::size_t line = 1;
+    std::size_t i = 0;
+    const auto byte = [&](std::size_t k) { return static_cast<unsigned char>(text[k]); };
+    const auto not_text = [&](unsigned char b) {
+        reporter.fail(line, "",
+                      fmt::format("byte 0x{:02X} is a control character: this is not a text file (a scene file is "
+                                  "UTF-8 TOML text)",
+                                  static_cast<unsigned>(b)));
+    };
+    const auto bad_utf8 = [&](std::size_t at) {
+        reporter.fail(line, "",
+                      fmt::format("invalid UTF-8 (byte 0x{:02X}): a scene file must be UTF-8 text",
+                                  static_cast<unsigned>(byte(at))));
+    };
+    while (i < text.size()) {
+        const unsigned char b = byte(i);
+        if (b < 0x80) {
+            if (b == '\n') ++line;
+            else if ((b < 0x20 && b != '\t' && b != '\r') || b == 0x7F) not_text(b);
+            ++i;
+            continue;
+        }
+        // The well-formed UTF-8 sequences (Unicode 15, table 3-7).
+        std::size_t continuation = 0;
+        unsigned char low = 0x80, high = 0xBF;  // range of the first continuation byte
+        if (b >= 0xC2 && b <= 0xDF) {
+            continuation = 1;
+        } else if (b == 0xE0) {
+            continuation = 2, low = 0xA0;
+        } else if ((b >= 0xE1 && b <= 0xEC) || b == 0xEE || b == 0xEF) {
+            continuation = 2;
+        } else if (b == 0xED) {
+            continuation = 2, high = 0x9F;
+        } else if (b == 0xF0) {
+            continuation = 3, low = 0x90;
+        } else if (b >= 0xF1 && b <= 0xF3) {
+            continuation = 3;
+        } else if (b == 0xF4) {
+            continuation = 3, high = 0x8F;
+        } else {
+            bad_utf8(i);
+        }
+        for (std::size_t k = 1; k <= continuation; ++k) {
+            if (i + k >= text.size()) bad_utf8(i);
+            const unsigned char c = byte(i + k);
+            const unsigned char lo = k == 1 ? low : 0x80, hi = k == 1 ? high : 0xBF;
+            if (c < lo || c > hi) bad_utf8(i + k);
+        }
+        i += continuation + 1;
+    }
+}
+
+toml::table parse_toml(std::string_view text, const Reporter& reporter) {
+    try {
+        return toml::parse(text, reporter.file());
+    } catch (const toml::parse_error& e) {
+        const auto& where = e.source().begin;
+        reporter.fail(where.line, "",
+                      fmt::format("TOML syntax error (column {}): {}", where.column, e.description()));
+    }
+}
+
+std::optional<std::string_view> closest(std::string_view word, const std::vector<std::string_view>& candidates) {
+    std::optional<std::string_view> best;
+    std::size_t best_distance = std::numeric_limits<std::size_t>::max();
+    for (const std::string_view c : candidates) {
+        const std::size_t d = edit_distance(word, c);
+        if (d < best_distance) best_distance = d, best = c;
+    }
+    // A few edits for a long word, and never a whole word replaced ("y" is no typo of "x").
+    const std::size_t length = std::min(word.size(), best ? best->size() : 0);
+    const std::size_t allowed = std::min(length <= 4 ? std::size_t{1} : length <= 8 ? std::size_t{2} : std::size_t{3},
+                                         length > 0 ? length - 1 : 0);
+    if (best && best_distance <= allowed) return best;
+    return std::nullopt;
+}
+
+std::size_t line_of(const toml::node& node) { return node.source().begin.line; }
+
+std::string_view type_name(const toml::node& node) {
+    switch (node.type()) {
+        case toml::node_type::table: return "a table";
+        case toml::node_type::array: return "an array";
+        case toml::node_type::string: return "a string";
+        case toml::node_type::integer: return "an integer";
+        case toml::node_type::floating_point: return "a number";
+        case toml::node_type::boolean: return "a boolean";
+        case toml::node_type::date: return "a date";
+        case toml::node_type::time: return "a time";
+        case toml::node_type::date_time: return "a date-time";
+        case toml::node_type::none: break;
+    }
+    return "nothing";
+}
+
+std::string as_written(const toml::node& node) {
+    if (const auto* s = node.as_string()) return in_quotes(s->get());
+    if (const auto* i = node.as_integer()) return fmt::format("{}", i->get());
+    if (const auto* f = node.as_floating_point()) {
+        const double v = f->get();
+        if (std::isnan(v)) return "nan";
+        if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
+        return fmt::format("{}", v);
+    }
+    if (const auto* b = node.as_boolean()) return b->get() ? "true" : "false";
+    return std::string(type_name(node));
+}
+
+double read_quantity(const Reporter& reporter, const toml::node& node, const std::string& key_path, Dimension d,
+                     Limit limit) {
+    const std::size_t line = line_of(node);
+    double value = 0.0;
+    if (const auto* i = node.as_integer()) {
+        value = static_cast<double>(i->get());
+    } else if (const auto* f = node.as_floating_point()) {
+        value = f->get();
+        if (std::isnan(value)) reporter.fail(line, key_path, fmt::format("nan is not allowed: a {} must be finite", noun_of(d)));
+        if (std::isinf(value) && !(limit == Limit::PositiveOrInfinite && value > 0)) {
+            reporter.fail(line, key_path, fmt::format("{} is not allowed: a {} must be finite", as_written(node), noun_of(d)));
+        }
+    } else if (const auto* s = node.as_string()) {
+        try {
+            value = parse_quantity(s->get(), d);
+        } catch (const UnitError& e) {
+            reporter.fail(line, key_path, e.what());
+        }
+    } else {
+        reporter.fail(line, key_path, fmt::format("expected {}, got {}", expected_quantity(d), type_name(node)));
+    }
+    switch (limit) {
+        case Limit::Any: break;
+        case Limit::Positive:
+        case Limit::PositiveOrInfinite:
+            if (!(value > 0.0)) {
+                reporter.fail(line, key_path, fmt::format("{} must be a positive {}", as_written(node), noun_of(d)));
+            }
+            break;
+        case Limit::NonNegative:
+            if (!(value >= 0.0)) {
+                reporter.fail(line, key_path, fmt::format("{} must not be negative", as_written(node)));
+            }
+            break;
+    }
+    return value;
+}
+
+TableReader::TableReader(const Reporter& reporter, const toml::table& table, std::string path, std::string what,
+                         std::vector<std::string_view> allowed)
+    : reporter_(reporter), table_(table), path_(std::move(path)) {
+    for (const auto& [key, node] : table_) {
+        const std::string_view k = key.str();
+        if (std::find(allowed.begin(), allowed.end(), k) != allowed.end()) continue;
+        std::size_t line = key.source().begin.line;
+        if (line == 0) line = line_of(node);
+        if (const auto suggestion = closest(k, allowed)) {
+            reporter_.fail(line, key_path(k), fmt::format("unknown key; did you mean \"{}\"?", *suggestion));
+        }
+        reporter_.fail(line, key_path(k), fmt::format("unknown key; {} takes {}", what, join(allowed)));
+    }
+}
+
+std::string TableReader::key_path(std::string_view key) const {
+    // Keys that are not bare words are quoted, as TOML would write them.
+    const bool bare = !key.empty() && std::all_of(key.begin(), key.end(), [](char c) {
+        return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '-';
+    });
+    const std::string k = bare ? std::string(key) : in_quotes(key);
+    return path_.empty() ? k : path_ + "." + k;
+}
+
+void TableReader::fail_at(std::string_view key, std::string_view message) const {
+    const toml::node* node = find(key);
+    reporter_.fail(node ? line_of(*node) : line_of(table_), key_path(key), message);
+}
+
+void TableReader::fail_table(std::string_view message) const { reporter_.fail(line_of(table_), path_, message); }
+
+void TableReader::fail_missing(std::string_view key, std::string_view what) const {
+    // The top level has no header line to point at.
+    reporter_.fail(path_.empty() ? 0 : line_of(table_), path_, fmt::format("missing required key \"{}\": {}", key, what));
+}
+
+std::optional<double> TableReader::quantity(std::string_view key, Dimension d, Limit limit) const {
+    const toml::node* node = find(key);
+    if (!node) return std::nullopt;
+    return read_quantity(reporter_, *node, key_path(key), d, limit);
+}
+
+double TableReader::required_quantity(std::string_view key, Dimension d, Limit limit) const {
+    const auto value = quantity(key, d, limit);
+    if (!value) fail_missing(key, expected_quantity(d));
+    return *value;
+}
+
+std::optional<std::string> TableReader::string(std::string_view key) const {
+    const toml::node* node = find(key);
+    if (!node) return std::nullopt;
+    const auto* s = node->as_string();
+    if (!s) fail_at(key, fmt::format("expected a string, got {} ({})", type_name(*node), as_written(*node)));
+    return s->get();
+}
+
+std::string TableReader::required_string(std::string_view key, std::string_view what) const {
+    auto value = string(key);
+    if (!value) fail_missing(key, what);
+    return *value;
+}
+
+std::optional<bool> TableReader::boolean(std::string_view key) const {
+    const toml::node* node = find(key);
+    if (!node) return std::nullopt;
+    const auto* b = node->as_boolean();
+    if (!b) fail_at(key, fmt::format("expected true or false, got {} ({})", type_name(*node), as_written(*node)));
+    return b->get();
+}
+
+std::optional<long long> TableReader::whole_number(std::string_view key, long long min, long long max) const {
+    const toml::node* node = find(key);
+    if (!node) return std::nullopt;
+    const std::string range = max == std::numeric_limits<long long>::max()
+                                  ? fmt::format("a whole number of at least {}", min)
+                                  : fmt::format("a whole number from {} to {}", min, max);
+    long long value = 0;
+    if (const auto* i = node->as_integer()) {
+        value = i->get();
+    } else if (const auto* f = node->as_floating_point()) {
+        // 1e6 is a fine way to write a step count.
+        const double v = f->get();
+        if (!(std::isfinite(v) && v == std::floor(v) && std::fabs(v) < 9.0e15)) {
+            fail_at(key, fmt::format("{} is not {}", as_written(*node), range));
+        }
+        value = static_cast<long long>(v);
+    } else {
+        fail_at(key, fmt::format("expected {}, got {} ({})", range, type_name(*node), as_written(*node)));
+    }
+    if (value < min || value > max) fail_at(key, fmt::format("{} is not {}", as_written(*node), range));
+    return value;
+}
+
+std::optional<std::vector<double>> TableReader::quantities(std::string_view key, Dimension d, std::size_t count,
+                                                           Limit limit, std::string_view components) const {
+    const toml::node* node = find(key);
+    if (!node) return std::nullopt;
+    const auto* array = node->as_array();
+    const std::string expected =
+        fmt::format("an array of {} {} {}", count, d == D::Dimensionless ? "numbers" : fmt::format("{} values", name_of(d)),
+                    components);
+    if (!array) fail_at(key, fmt::format("expected {}, got {} ({})", expected, type_name(*node), as_written(*node)));
+    if (array->size() != count) {
+        fail_at(key, fmt::format("expected {}, got {} value{}", expected, array->size(), array->size() == 1 ? "" : "s"));
+    }
+    std::vector<double> values;
+    for (std::size_t i = 0; i < count; ++i) {
+        values.push_back(read_quantity(reporter_, (*array)[i], fmt::format("{}[{}]", key_path(key), i), d, limit));
+    }
+    return values;
+}
+
+void TableReader::fail_choice(std::string_view key, std::string_view word,
+                              const std::vector<std::string_view>& names) const {
+    std::string message = fmt::format("{} is not one of {}", in_quotes(word), join_quoted(names));
+    if (const auto suggestion = closest(word, names)) message += fmt::format(" (did you mean \"{}\"?)", *suggestion);
+    fail_at(key, message);
+}
+
+}  // namespace gpa::io::detail
