@@ -1,5 +1,6 @@
 #include "gpa/io/output.hpp"
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
@@ -191,6 +192,62 @@ void write_summary(const fs::path& file, const Simulation& sim, const RunSummary
     {
         std::ofstream out(tmp);
         out << j;
+        if (!out) throw OutputError(fmt::format("cannot write '{}'", tmp.string()));
+    }
+    std::error_code ec;
+    fs::rename(tmp, file, ec);
+    if (ec) throw OutputError(fmt::format("cannot rename '{}': {}", tmp.string(), ec.message()));
+}
+
+void write_profile(const fs::path& file, const Simulation& sim) {
+    const Scene& scene = sim.scene();
+    const auto plane = std::find_if(scene.planes.begin(), scene.planes.end(),
+                                    [](const PlaneSpec& p) { return p.kind == PlaneKind::Rigid; });
+    if (plane == scene.planes.end()) return;
+    const NodeStore& n = sim.nodes();
+    const std::size_t count = sim.real_count();
+    if (count == 0) return;
+    const int dim = n.dim();
+    // The horizontal axes: those other than the plane's normal.
+    std::vector<int> across;
+    for (int c = 0; c < dim; ++c) {
+        if (c != plane->axis) across.push_back(c);
+    }
+    std::array<double, 3> centre{0, 0, 0};
+    if (dim == 3) {
+        for (std::size_t i = 0; i < count; ++i) {
+            for (int c : across) centre[c] += n.position[c][i] / double(count);
+        }
+    }
+    double mean_d = 0.0, top = 0.0;
+    for (std::size_t i = 0; i < count; ++i) {
+        mean_d += n.diameter[i] / double(count);
+        top = std::max(top, plane->side * (n.position[plane->axis][i] - plane->position) + 0.5 * n.diameter[i]);
+    }
+    const double bin = 0.5 * mean_d;
+    const std::size_t bins = static_cast<std::size_t>(std::ceil(top / bin)) + 1;
+    std::vector<double> radius(bins, -1.0);
+    for (std::size_t i = 0; i < count; ++i) {
+        const double h = plane->side * (n.position[plane->axis][i] - plane->position);
+        double r = 0.0;
+        if (dim == 3) {
+            for (int c : across) r += (n.position[c][i] - centre[c]) * (n.position[c][i] - centre[c]);
+            r = std::sqrt(r);
+        } else {
+            r = n.position[across[0]][i];  // x: the radius in axisymmetric geometry
+        }
+        const auto k = static_cast<std::size_t>(std::clamp(h / bin, 0.0, double(bins - 1)));
+        radius[k] = std::max(radius[k], r + 0.5 * n.diameter[i]);
+    }
+    auto tmp = file;
+    tmp += ".tmp";
+    {
+        std::ofstream out(tmp);
+        out << "height_m,radius_m\n";
+        for (std::size_t k = 0; k < bins; ++k) {
+            if (radius[k] >= 0.0) out << fmt::format("{:.6e},{:.6e}\n", (double(k) + 0.5) * bin, radius[k]);
+        }
+        out << fmt::format("{:.6e},{:.6e}\n", top, 0.0);
         if (!out) throw OutputError(fmt::format("cannot write '{}'", tmp.string()));
     }
     std::error_code ec;

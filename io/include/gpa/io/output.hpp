@@ -82,6 +82,13 @@ struct RunSummary {
 // and step counts, threads, wall time per phase, and node-steps per second.
 void write_summary(const std::filesystem::path& file, const Simulation& sim, const RunSummary& run);
 
+// profile.csv: the outline of the bodies seen from the first rigid plane, for comparing a
+// Taylor specimen with its measured outline: for bins of height above the plane (half a mean
+// node diameter wide), the largest radial extent x + d/2 (2D; in 3D the distance from the
+// vertical through the nodes' centroid, plus d/2). Heights and radii in m. Does nothing
+// without a rigid plane.
+void write_profile(const std::filesystem::path& file, const Simulation& sim);
+
 // The scene's reference answers compared with the run: key -> {reference, computed, relative error}.
 struct ReferenceComparison {
     std::string key;
