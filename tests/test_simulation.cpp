@@ -1,32 +1,234 @@
 // Whole runs of the engine: energy and momentum balances, an elastic bar against a rigid plane,
-// and thread independence.
+// smoothing, thread independence, and the phases a scene's graph holds.
 
 #include <cmath>
 #include <cstring>
+#include <random>
 
 #include <gtest/gtest.h>
 
+#include "gpa/engine/ghosts.hpp"
+#include "gpa/engine/neighbours.hpp"
 #include "gpa/engine/simulation.hpp"
+#include "gpa/engine/smoothing.hpp"
+#include "support/lattices.hpp"
 #include "support/scenes.hpp"
 
 namespace gpa {
 namespace {
 
-TEST(ElasticBar, ContactTimeAndReboundSpeed) {
+double total_mass(const Simulation& sim) {
+    double m = 0.0;
+    for (std::size_t i = 0; i < sim.real_count(); ++i) m += sim.nodes().mass[i];
+    return m;
+}
+
+double axial_momentum(const Simulation& sim) {
+    double p = 0.0;
+    for (std::size_t i = 0; i < sim.real_count(); ++i) p += sim.nodes().mass[i] * sim.nodes().velocity[1][i];
+    return p;
+}
+
+// Elastic bar (nu = 0, so bar and dilatational speeds agree), 10 diameters long, no viscosity,
+// lift-off allowed, 10 nodes across the radius (2000 nodes).
+TEST(ElasticBar, ContactTimeAndReboundSpeedWithinTwoPercent) {
     const double radius = 1e-3, length = 20e-3, speed = 10.0;
-    auto scene = testing::elastic_bar_on_plane(radius, length, 5, speed);
-    Simulation sim(scene, 2);
-    const double c = std::sqrt(200e9 / 7800.0);
+    Simulation sim(testing::elastic_bar_on_plane(radius, length, 10, speed), 2);
+    const double c = std::sqrt(200e9 / 7800.0), mass = total_mass(sim);
     double last_contact = 0.0;
-    double mass = 0.0;
-    for (std::size_t i = 0; i < sim.real_count(); ++i) mass += sim.nodes().mass[i];
     while (!sim.finished()) {
         sim.step();
         if (sim.totals().planes.at(0).reaction != 0.0) last_contact = sim.time();
     }
-    const double rebound = sim.totals().momentum[1] / mass;
-    std::printf("[ measured ] contact %.4g us (2L/c %.4g us), rebound %.4g m/s, energy error %.3g, %zu steps\n",
-                last_contact * 1e6, 2 * length / c * 1e6, rebound, sim.totals().energy_error, sim.steps());
+    ASSERT_GT(sim.time(), 1.2 * last_contact) << "the run must outlast the contact";
+    const double rebound = axial_momentum(sim) / mass;
+    std::printf("[ measured ] contact %.4g us vs 2L/c %.4g us (%+.2f %%), rebound %.4g m/s (%+.2f %%), energy error %.2g\n",
+                last_contact * 1e6, 2 * length / c * 1e6, 100 * (last_contact * c / (2 * length) - 1), rebound,
+                100 * (rebound / speed - 1), sim.totals().energy_error);
+    // The acceptance: 2 % on both (measured at this resolution: about +0.6 % and -1.4 %).
+    EXPECT_NEAR(last_contact, 2.0 * length / c, 0.02 * 2.0 * length / c);
+    EXPECT_NEAR(rebound, speed, 0.02 * speed);
+}
+
+// The paper's Armco-iron cylinder (nodal viscosity) at 8 nodes across the radius, to 40 us.
+TEST(ArmcoCylinder, EnergyBalanceClosesWithinOnePercent) {
+    Simulation sim(testing::armco_cylinder(8, 40e-6), 2);
+    const double e0 = sim.totals().initial_energy;
+    double worst = 0.0;
+    while (!sim.finished()) {
+        sim.step();
+        worst = std::max(worst, std::abs(sim.totals().energy_error));
+    }
+    const auto& t = sim.totals();
+    std::printf("[ measured ] worst |KE + IE + boundary work - E0| / E0 = %.3g over %zu steps; final KE %.3g J, IE %.4g J "
+                "(plastic %.4g J, viscous %.4g J), boundary %.3g J, E0 %.4g J; L %.3f mm, D %.3f mm\n",
+                worst, t.step, t.kinetic_energy, t.internal_energy, t.plastic_work, t.viscous_work, t.boundary_work, e0,
+                t.length * 1e3, t.footprint_diameter * 1e3);
+    // Plastic and viscous work are booked in the internal energy (which also holds the work of the
+    // thermal pressure, so it need not exceed their sum); the boundary work holds what the sliding
+    // condition removed. The balance closes within the 1 % (the scheme's error is first
+    // order in dt: 1.07 % at C_cfl 0.3, 0.56 % at 0.15 were measured for this run).
+    EXPECT_GT(t.plastic_work, 0.5 * e0) << "most of the impact energy should become plastic work";
+    EXPECT_GT(t.viscous_work, 0.0);
+    EXPECT_LT(worst, 0.01);
+    EXPECT_LT(t.kinetic_energy, 0.01 * e0) << "the bar should have come to rest by 40 us";
+}
+
+TEST(Momentum, AxialMomentumChangesOnlyByThePlaneImpulse) {
+    Simulation sim(testing::armco_cylinder(6, 40e-6), 2);
+    double p0 = 0.0;
+    for (std::size_t i = 0; i < sim.real_count(); ++i) p0 += sim.nodes().mass[i] * -305.0;
+    for (int k = 0; k < 400; ++k) sim.step();
+    const double impulse = sim.totals().planes.at(0).impulse;
+    ASSERT_GT(impulse, 0.05 * std::abs(p0)) << "the plane must have pushed";
+    // Velocities after step() are the half step ahead, and so is the impulse (spec section 11).
+    EXPECT_NEAR(axial_momentum(sim) - p0, impulse, 1e-11 * std::abs(p0));
+}
+
+TEST(Momentum, WithoutPlanesItIsConservedToRoundOff) {
+    auto scene = testing::elastic_bar_on_plane(1e-3, 10e-3, 5, 10.0);
+    scene.planes.clear();
+    scene.bodies[0].velocity = {0.0, 0.0, 0.0};
+    scene.bodies[0].initial_stress = {-1e8, 2e8, 5e7, 0.0, 0.0, 0.0};  // it must move
+    scene.solver.viscosity = ViscosityKind::Nodal;
+    scene.stop.max_steps = 300;
+    Simulation sim(scene, 2);
+    for (int k = 0; k < 300; ++k) sim.step();
+    double speed = 0.0;
+    for (std::size_t i = 0; i < sim.real_count(); ++i) speed = std::max(speed, std::abs(sim.nodes().velocity[1][i]));
+    ASSERT_GT(speed, 1.0) << "the prestressed bar must be moving";
+    EXPECT_NEAR(axial_momentum(sim), 0.0, 1e-13 * total_mass(sim) * speed);
+}
+
+std::vector<std::uint8_t> bytes_of(const NodeStore& n, std::size_t count) {
+    std::vector<std::uint8_t> out;
+    const auto add = [&](const std::vector<double>& v) {
+        const auto* p = reinterpret_cast<const std::uint8_t*>(v.data());
+        out.insert(out.end(), p, p + count * sizeof(double));
+    };
+    for (int c = 0; c < n.dim(); ++c) {
+        add(n.position[c]);
+        add(n.velocity[c]);
+        add(n.force[c]);
+    }
+    for (int c = 0; c < 4; ++c) add(n.deviatoric_stress[c]);
+    add(n.pressure);
+    add(n.internal_energy);
+    add(n.plastic_strain);
+    add(n.temperature);
+    add(n.volume);
+    return out;
+}
+
+TEST(Threads, AFullShortRunIsBitIdenticalOnOneAndTwoThreads) {
+    for (bool smoothing : {false, true}) {
+        auto scene = testing::armco_cylinder(6, 40e-6);
+        if (smoothing) scene.solver.smoothing = SmoothingMode::Everywhere;
+        scene.solver.reorder_interval = 50;
+        Simulation one(scene, 1), two(scene, 2);
+        for (int k = 0; k < 250; ++k) {
+            one.step();
+            two.step();
+        }
+        ASSERT_EQ(one.real_count(), two.real_count());
+        EXPECT_TRUE(bytes_of(one.nodes(), one.real_count()) == bytes_of(two.nodes(), two.real_count()))
+            << (smoothing ? "with smoothing" : "without smoothing");
+        EXPECT_EQ(std::memcmp(&one.totals().energy_error, &two.totals().energy_error, sizeof(double)), 0);
+    }
+}
+
+TEST(PhaseGraph, HoldsOnlyThePhasesTheSceneNeeds) {
+    auto scene = testing::armco_cylinder(4, 1e-6);
+    const auto plain = Simulation(scene, 1).phases();
+    EXPECT_EQ(std::count(plain.begin(), plain.end(), "smoothing"), 0);
+    EXPECT_EQ(std::count(plain.begin(), plain.end(), "switching"), 0);
+    scene.solver.smoothing = SmoothingMode::Tension;
+    scene.solver.connectivity = ConnectivityMode::Automatic;
+    const auto full = Simulation(scene, 1).phases();
+    EXPECT_EQ(std::count(full.begin(), full.end(), "smoothing"), 1);
+    EXPECT_EQ(std::count(full.begin(), full.end(), "switching"), 1);
+}
+
+// Smoothing (Eq. 66-73) on an axisymmetric block against the axis and a rigid plane, with its
+// ghosts in the lists: one application.
+struct SmoothingSetup {
+    NodeStore nodes{GeometryKind::Axisymmetric};
+    std::size_t real = 0;
+    CompressedRows lists;
+    GhostSet ghosts;
+
+    SmoothingSetup() {
+        ghosts = GhostSet({{"axis", 0, 0.0, +1, false, false}, {"plane", 1, 0.0, +1, false, true}});
+        LatticeBlock b;
+        b.spacing = {1e-3, 1e-3, 1e-3};
+        b.last = {10, 12, 1};
+        b.density = 7800.0;
+        b.mirror_planes = ghosts.mirror_planes();
+        fill_lattice(nodes, b);
+        real = nodes.size();
+        testing::jitter(nodes, 0.1, 1e-3, 3);
+        ghosts.update_contacts(nodes, real, true);
+        ghosts.build(nodes, real, largest_interaction_radius(nodes, 1.0, real));
+        NeighbourScratch scratch;
+        find_neighbours(nodes, 1.0, real, lists, scratch, &ghosts.resolved_fixed_mirrors(nodes, real));
+        ghosts.append_ghost_rows(lists, real);
+    }
+
+    double smooth(SmoothingMode mode) {
+        SmoothingScratch scratch;
+        const PositionView x{2, {nodes.position[0].data(), nodes.position[1].data(), nullptr}};
+        const auto plan = make_slab_plan(lists, x);
+        return smooth_velocities<Axisymmetric>(lists, plan, WeightKind::Gpa, pair_fields<2>(nodes, 1.0), real,
+                                               {0.1, mode == SmoothingMode::Tension},
+                                               {nodes.velocity[0].data(), nodes.velocity[1].data()}, nodes.mass.data(),
+                                               nodes.pressure.data(), nodes.internal_energy.data(), scratch);
+    }
+};
+
+TEST(Smoothing, LeavesAUniformFieldUnchanged) {
+    SmoothingSetup s;
+    for (std::size_t i = 0; i < s.nodes.size(); ++i) {
+        s.nodes.velocity[0][i] = 3.0;
+        s.nodes.velocity[1][i] = -250.0;
+    }
+    s.smooth(SmoothingMode::Everywhere);
+    for (std::size_t i = 0; i < s.real; ++i) {
+        EXPECT_NEAR(s.nodes.velocity[0][i], 3.0, 1e-12);
+        EXPECT_NEAR(s.nodes.velocity[1][i], -250.0, 1e-12);
+        EXPECT_NEAR(s.nodes.internal_energy[i], 0.0, 1e-9);
+    }
+}
+
+TEST(Smoothing, ConservesMomentumAndTotalEnergyNextToPlaneAndAxis) {
+    for (auto mode : {SmoothingMode::Everywhere, SmoothingMode::Tension}) {
+        SmoothingSetup s;
+        std::mt19937_64 rng(4);
+        std::uniform_real_distribution<double> u(-100.0, 100.0);
+        for (std::size_t i = 0; i < s.real; ++i) {
+            s.nodes.velocity[0][i] = u(rng);
+            s.nodes.velocity[1][i] = u(rng);
+            s.nodes.pressure[i] = u(rng);  // about half the centres in tension
+        }
+        std::array<double, 2> p0{0, 0};
+        double e0 = 0.0, scale = 0.0;
+        for (std::size_t i = 0; i < s.real; ++i) {
+            const double m = s.nodes.mass[i];
+            for (int c = 0; c < 2; ++c) p0[c] += m * s.nodes.velocity[c][i];
+            e0 += 0.5 * m * (std::pow(s.nodes.velocity[0][i], 2) + std::pow(s.nodes.velocity[1][i], 2)) + m * s.nodes.internal_energy[i];
+            scale += m * 100.0;
+        }
+        const double moved = s.smooth(mode);
+        ASSERT_GT(moved, 1e-3 * e0) << "smoothing did nothing measurable";
+        std::array<double, 2> p1{0, 0};
+        double e1 = 0.0;
+        for (std::size_t i = 0; i < s.real; ++i) {
+            const double m = s.nodes.mass[i];
+            for (int c = 0; c < 2; ++c) p1[c] += m * s.nodes.velocity[c][i];
+            e1 += 0.5 * m * (std::pow(s.nodes.velocity[0][i], 2) + std::pow(s.nodes.velocity[1][i], 2)) + m * s.nodes.internal_energy[i];
+        }
+        for (int c = 0; c < 2; ++c) EXPECT_NEAR(p1[c], p0[c], 1e-13 * scale) << "component " << c;
+        EXPECT_NEAR(e1, e0, 1e-13 * e0);
+    }
 }
 
 }  // namespace
