@@ -5,4 +5,4 @@ cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release
 cmake --build build --target gpa_cli -j"$(nproc)"
-./build/apps/gpa "$@"
+./build/apps/gpa run "$@"
