@@ -41,39 +41,16 @@ GhostSet::GhostSet(std::vector<GhostPlane> planes) : planes_(std::move(planes)) 
     index_.resize(masks_.size());
     for (std::size_t p = 0; p < planes_.size(); ++p) {
         if (planes_[p].lift_off) lift_off_mask_ |= static_cast<std::uint8_t>(1u << p);
-        if (planes_[p].rigid) rigid_mask_ |= static_cast<std::uint8_t>(1u << p);
     }
-}
-
-double GhostSet::constrain_contact_velocities(NodeStore& nodes, std::size_t real_count, std::vector<double>& impulse) const {
-    if (rigid_mask_ == 0) return 0.0;
-    impulse.resize(planes_.size(), 0.0);
-    double removed = 0.0;
-    // Serial: few nodes touch a plane, and the sums keep one order.
-    for (std::size_t i = 0; i < real_count; ++i) {
-        const std::uint8_t touching = nodes.plane_contact[i] & rigid_mask_;
-        if (touching == 0) continue;
-        for (std::size_t p = 0; p < planes_.size(); ++p) {
-            if (!((touching >> p) & 1u)) continue;
-            double& v = nodes.velocity[planes_[p].axis][i];
-            const double outward = planes_[p].side * v;  // > 0: leaving the plane
-            if (outward < 0.0 || (!planes_[p].lift_off && outward > 0.0)) {
-                removed += 0.5 * nodes.mass[i] * v * v;
-                impulse[p] -= nodes.mass[i] * outward;
-                v = 0.0;
-            }
-        }
-    }
-    return removed;
 }
 
 void GhostSet::update_contacts(NodeStore& nodes, std::size_t real_count, bool initial) const {
-    if (rigid_mask_ == 0) return;
+    if (lift_off_mask_ == 0) return;
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, real_count, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
         for (std::size_t i = r.begin(); i != r.end(); ++i) {
             std::uint8_t bits = nodes.plane_contact[i];
             for (std::size_t p = 0; p < planes_.size(); ++p) {
-                if (!planes_[p].rigid) continue;
+                if (!planes_[p].lift_off) continue;
                 const auto bit = static_cast<std::uint8_t>(1u << p);
                 const int a = planes_[p].axis;
                 const double gap = planes_[p].distance(nodes.position[a][i]);
@@ -81,12 +58,9 @@ void GhostSet::update_contacts(NodeStore& nodes, std::size_t real_count, bool in
                 if (initial) {
                     bits = close ? (bits | bit) : (bits & ~bit);
                 } else if (bits & bit) {
-                    if (planes_[p].lift_off) {
-                        // sigma_nn = s_nn - P - Q: tension (> 0) releases the node.
-                        const double normal_stress =
-                            nodes.deviatoric_stress[a][i] - nodes.pressure[i] - nodes.viscous_pressure[i];
-                        if (normal_stress > 0.0 || !close) bits &= static_cast<std::uint8_t>(~bit);
-                    }
+                    // sigma_nn = s_nn - P - Q: tension (> 0) releases the node.
+                    const double normal_stress = nodes.deviatoric_stress[a][i] - nodes.pressure[i] - nodes.viscous_pressure[i];
+                    if (normal_stress > 0.0 || !close) bits &= static_cast<std::uint8_t>(~bit);
                 } else if (close && planes_[p].side * nodes.velocity[a][i] < 0.0) {
                     bits |= bit;
                 }

@@ -333,12 +333,6 @@ void Simulation::Impl::integrate(double dt_avg) {
         }
     });
     for (std::size_t k = 0; k < reaction.size(); ++k) impulse[k] += reaction[k] * dt_avg;
-    if (!rigid_planes.empty()) {
-        // Sliding condition of the nodes on rigid planes; what it removes is booked.
-        std::vector<double> removed_momentum;
-        boundary_work += ghosts.constrain_contact_velocities(nodes, real, removed_momentum);
-        for (std::size_t k = 0; k < rigid_planes.size(); ++k) impulse[k] += removed_momentum[rigid_planes[k]];
-    }
     if (scene.solver.viscosity == ViscosityKind::Bond) {
         // The work of the bond-viscous forces becomes internal energy of the centre (spec section 5).
         const double work = tbb::parallel_deterministic_reduce(

@@ -59,7 +59,9 @@ struct ReturnResult {
 
 // Radial return of the trial deviator to the flow stress of `strength` at plastic strain
 // eps_p, strain rate (1/s) and homologous temperature; shear modulus G (Pa).
+// dt: the step's length; the Johnson-Cook rate term uses the equivalent plastic strain rate
+// d eps_p / dt of the return itself (Johnson and Cook 1983 define epsdot* so).
 ReturnResult radial_return(const Strength& strength, const Eigen::Matrix3d& trial, double shear_modulus,
-                           double plastic_strain, double strain_rate, double homologous_temperature);
+                           double plastic_strain, double dt, double homologous_temperature);
 
 }  // namespace gpa::materials::detail

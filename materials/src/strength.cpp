@@ -72,23 +72,34 @@ ReturnResult project(const Eigen::Matrix3d& trial, double trial_equivalent, doub
     return r;
 }
 
-// Johnson-Cook radial return with hardening: solve
-//   f(x) = sigma_eq* - 3 G x - Y(eps_p + x) = 0,   x = d eps_p,
-// by Newton's method safeguarded with bisection. f(0) > 0 (the trial is beyond yield) and f is
-// decreasing because Y does not fall with eps_p; at the perfectly plastic estimate
-// x_hi = (sigma_eq* - Y(eps_p)) / (3 G) f = Y(eps_p) - Y(eps_p + x_hi) <= 0, so [0, x_hi] brackets
-// the root. Stop when |f| <= 1e-13 sigma_eq* or the bracket has shrunk to round-off; the deviator
-// is then scaled to Y(eps_p + x) itself, so it lies on the yield surface to round-off, and the
-// consistency residual sigma_eq* - 3 G x - Y is within the tolerance.
+// Johnson-Cook radial return with hardening and rate hardening: solve
+//   f(x) = sigma_eq* - 3 G x - Y(eps_p + x, x / dt) = 0,   x = d eps_p,
+// by Newton's method safeguarded with bisection. The rate is the equivalent plastic strain rate
+// of the step, as Johnson and Cook (1983) define epsdot*: it depends on the unknown x, and Y does
+// not fall with x (strain hardening and the rate term, floored at epsdot0, both rise), so f falls
+// from f(0) > 0 and the perfectly plastic estimate x_hi = (sigma_eq* - Y(eps_p, 0)) / (3 G), at
+// which f <= 0, brackets the root. Stop when |f| <= 1e-13 sigma_eq* or the bracket has shrunk to
+// round-off; the deviator is then scaled to Y(eps_p + x, x / dt) itself, so it lies on the yield
+// surface to round-off.
 ReturnResult johnson_cook_return(const JohnsonCookStrength& jc, const Eigen::Matrix3d& trial, double trial_equivalent,
-                                 double shear_modulus, double plastic_strain, double strain_rate,
-                                 double t_star, double initial_flow_stress) {
+                                 double shear_modulus, double plastic_strain, double dt, double t_star,
+                                 double initial_flow_stress) {
     const double three_g = 3.0 * shear_modulus;
+    const auto rate_of = [dt](double x) { return dt > 0.0 ? x / dt : 0.0; };
+    // Y and dY/dx at x: the strain slope plus the rate term's d/dx of C ln(x / (dt epsdot0)).
+    const auto flow = [&](double x) {
+        FlowStress y = johnson_cook_flow(jc, plastic_strain + x, rate_of(x), t_star);
+        if (x > 0.0 && rate_of(x) > jc.reference_strain_rate) {
+            const double rate_factor = 1.0 + jc.c * std::log(rate_of(x) / jc.reference_strain_rate);
+            y.slope += y.stress / rate_factor * jc.c / x;
+        }
+        return y;
+    };
     double lo = 0.0;
     double hi = (trial_equivalent - initial_flow_stress) / three_g;
     double x = hi;
     const double tolerance = 1e-13 * trial_equivalent;
-    FlowStress y = johnson_cook_flow(jc, plastic_strain + x, strain_rate, t_star);
+    FlowStress y = flow(x);
     for (int iteration = 0; iteration < 200; ++iteration) {
         const double f = trial_equivalent - three_g * x - y.stress;
         if (std::abs(f) <= tolerance) {
@@ -102,9 +113,9 @@ ReturnResult johnson_cook_return(const JohnsonCookStrength& jc, const Eigen::Mat
         if (hi - lo <= 4.0 * std::numeric_limits<double>::epsilon() * hi) {
             break;
         }
-        const double newton = x + f / (three_g + y.slope);  // f' = -(3 G + dY/d eps_p)
+        const double newton = x + f / (three_g + y.slope);  // f' = -(3 G + dY/dx)
         x = (newton > lo && newton < hi) ? newton : 0.5 * (lo + hi);
-        y = johnson_cook_flow(jc, plastic_strain + x, strain_rate, t_star);
+        y = flow(x);
     }
     return project(trial, trial_equivalent, y.stress, x);
 }
@@ -117,7 +128,7 @@ ReturnResult johnson_cook_return(const JohnsonCookStrength& jc, const Eigen::Mat
 // (materials.md). With G = 0 no elastic strain exists to turn plastic: the deviator is only
 // scaled back and d eps_p = 0.
 ReturnResult radial_return(const Strength& strength, const Eigen::Matrix3d& trial, double shear_modulus,
-                           double plastic_strain, double strain_rate, double homologous_temperature) {
+                           double plastic_strain, double dt, double homologous_temperature) {
     ReturnResult elastic;
     elastic.deviator = trial;
     if (std::holds_alternative<ElasticStrength>(strength)) {
@@ -137,7 +148,7 @@ ReturnResult radial_return(const Strength& strength, const Eigen::Matrix3d& tria
     }
 
     const auto& jc = std::get<JohnsonCookStrength>(strength);
-    const double y0 = johnson_cook_flow(jc, plastic_strain, strain_rate, t_star).stress;
+    const double y0 = johnson_cook_flow(jc, plastic_strain, 0.0, t_star).stress;  // no plastic flow yet: no rate term
     elastic.flow_stress = y0;
     if (!(trial_equivalent > y0)) {
         return elastic;
@@ -145,7 +156,7 @@ ReturnResult radial_return(const Strength& strength, const Eigen::Matrix3d& tria
     if (!(shear_modulus > 0.0)) {
         return project(trial, trial_equivalent, y0, 0.0);
     }
-    return johnson_cook_return(jc, trial, trial_equivalent, shear_modulus, plastic_strain, strain_rate, t_star, y0);
+    return johnson_cook_return(jc, trial, trial_equivalent, shear_modulus, plastic_strain, dt, t_star, y0);
 }
 
 }  // namespace detail

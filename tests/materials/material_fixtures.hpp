@@ -2,6 +2,7 @@
 // Materials and a small driver shared by the material tests. Constants from materials.md.
 
 #include <cmath>
+#include <limits>
 #include <utility>
 
 #include <Eigen/Core>
@@ -61,6 +62,16 @@ inline Eigen::Matrix3d pure_shear(double gamma_dot) {
     Eigen::Matrix3d l = Eigen::Matrix3d::Zero();
     l(0, 1) = l(1, 0) = 0.5 * gamma_dot;
     return l;
+}
+
+// The plastic strain increment of a step read back as eps_after - eps_before differs from the
+// increment x the return computed by the rounding of eps_before + x when it was stored (at most
+// eps_machine/2 eps_after) and of the subtraction (eps_machine/2 x); x recovered from the reported
+// plastic rate as (x / dt) dt carries two more roundings (eps_machine x). With x <= eps_after the
+// sum is at most 2 eps_machine eps_after: this bound, with a factor-2 margin, is how closely the
+// read-back increment, the reported rate times dt and x can be compared.
+inline double increment_read_back_tolerance(double plastic_strain_after) {
+    return 4.0 * std::numeric_limits<double>::epsilon() * plastic_strain_after;
 }
 
 // Drives one point with a constant-in-step velocity gradient; density follows

@@ -2,7 +2,9 @@
 // damage accumulation, failure at D >= 1 (no deviator, no tension afterwards), spall only when
 // failure is enabled.
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include <gtest/gtest.h>
 
@@ -22,8 +24,11 @@ constexpr double kRoundOff = 1e-12;
 const JohnsonCookFailure kCopperFracture{0.54, 4.89, -3.03, 0.014, 1.12, 1.0, 0.01};
 const JohnsonCookFailure kIronFracture{-2.20, 5.43, -0.47, 0.016, 0.63, 1.0, 0.01};
 
+// The closed form of materials.md, with epsdot* = max(epsdot / epsdot0, 1) written out (no floor
+// at min_failure_strain: the tests apply it where they need it).
 double eps_f_closed_form(const JohnsonCookFailure& f, double sigma_star, double rate, double t_star) {
-    return (f.d1 + f.d2 * std::exp(f.d3 * sigma_star)) * (1.0 + f.d4 * std::log(rate)) * (1.0 + f.d5 * t_star);
+    const double rate_ratio = std::max(rate / f.reference_strain_rate, 1.0);
+    return (f.d1 + f.d2 * std::exp(f.d3 * sigma_star)) * (1.0 + f.d4 * std::log(rate_ratio)) * (1.0 + f.d5 * t_star);
 }
 
 TEST(JohnsonCookFailureStrain, MatchesClosedForm) {
@@ -61,7 +66,8 @@ TEST(JohnsonCookFailureStrain, FloorAndGuards) {
 }
 
 // Copper strength with a linear EOS, no heating (T* = 0 throughout) and a fracture set with a
-// small failure strain: in pure shear P = 0, sigma* = 0, eps_f = (D1 + D2)(1 + D4 ln epsdot*).
+// small failure strain: in pure shear P = 0, sigma* = 0, eps_f = (D1 + D2)(1 + D4 ln epsdot*), with
+// epsdot* the step's equivalent plastic strain rate d eps_p / dt over epsdot0.
 Material shear_failure_material() {
     Material m = test::copper_linear();
     m.specific_heat = 0.0;
@@ -71,20 +77,38 @@ Material shear_failure_material() {
 
 TEST(Damage, AccumulatesPlasticStrainOverFailureStrainAndFailsAtOne) {
     const Material m = shear_failure_material();
+    const JohnsonCookFailure& f = *m.failure.johnson_cook;
     Driver p(m);
     p.failure_enabled = true;
     const double gamma_dot = 1e3, dt = 1e-7;
-    const double rate = gamma_dot / std::sqrt(3.0);
-    const double eps_f = 0.1 * (1.0 + 0.01 * std::log(rate));
+    const double total_rate = gamma_dot / std::sqrt(3.0);
+    // D = sum d eps_p / eps_f(sigma* = 0, d eps_p / dt, T* = 0), step by step: eps_f follows the plastic
+    // rate, which is below the total rate (part of each hardening step's strain is elastic) and
+    // varies along the path.
+    double expected_damage = 0.0;
+    double eps_f_min = std::numeric_limits<double>::infinity(), eps_f_max = 0.0;
+    double eps_before_failure_step = 0.0;
     int failure_step = -1;
     for (int step = 0; step < 10000 && failure_step < 0; ++step) {
         const double damage_before = p.state.damage;
+        const double eps_before = p.state.plastic_strain;
         const PointResult r = p.step(pure_shear(gamma_dot), dt);
         EXPECT_EQ(p.state.pressure, 0.0);
-        // D = sum d eps_p / eps_f with eps_f constant on this path.
-        EXPECT_NEAR(p.state.damage, p.state.plastic_strain / eps_f, kRoundOff * std::max(p.state.damage, 1e-3));
+        const double d_eps = p.state.plastic_strain - eps_before;
+        EXPECT_NEAR(r.plastic_strain_rate * dt, d_eps, test::increment_read_back_tolerance(p.state.plastic_strain));
+        if (d_eps > 0.0) {
+            EXPECT_LT(r.plastic_strain_rate, total_rate);
+            const double eps_f = eps_f_closed_form(f, 0.0, d_eps / dt, 0.0);
+            eps_f_min = std::min(eps_f_min, eps_f);
+            eps_f_max = std::max(eps_f_max, eps_f);
+            expected_damage += d_eps / eps_f;
+        }
+        // Sums of a few thousand terms, each rounded once as in the library; d eps_p read back from
+        // the stored plastic strain telescopes, so the increments' read-back errors do not add up.
+        EXPECT_NEAR(p.state.damage, expected_damage, kRoundOff * std::max(expected_damage, 1e-3));
         if (r.failed_now) {
             failure_step = step;
+            eps_before_failure_step = eps_before;
             EXPECT_LT(damage_before, 1.0);
             EXPECT_GE(p.state.damage, 1.0);
             EXPECT_TRUE(p.state.failed);
@@ -93,7 +117,16 @@ TEST(Damage, AccumulatesPlasticStrainOverFailureStrainAndFailsAtOne) {
         }
     }
     ASSERT_GT(failure_step, 0);
-    EXPECT_NEAR(p.state.plastic_strain, eps_f, 1e-4);  // within one step's d eps_p (5.8e-5)
+    // eps_f varies along the path (from the first-yield step's slow plastic rate, ~3 /s, to nearly
+    // the total rate, 577 /s: eps_f from ~0.1012 to ~0.1064), and D = 1 is reached between the
+    // bounds it implies:
+    // eps_p / eps_f_max <= D <= eps_p / eps_f_min, with D < 1 before the last step and D >= 1 after it.
+    EXPECT_GT(eps_f_max - eps_f_min, 1e-3);
+    EXPECT_GE(p.state.plastic_strain, eps_f_min);
+    EXPECT_LT(eps_before_failure_step, eps_f_max);
+    // The damage differs from that with the old total-rate eps_f by far more than the tolerance above.
+    EXPECT_GT(std::abs(p.state.damage - p.state.plastic_strain / eps_f_closed_form(f, 0.0, total_rate, 0.0)),
+              1e3 * kRoundOff);
     // Failed: no deviator, shear modulus gone from the sound speed.
     EXPECT_EQ(von_mises(p.state.deviatoric_stress), 0.0);
 
@@ -101,6 +134,7 @@ TEST(Damage, AccumulatesPlasticStrainOverFailureStrainAndFailsAtOne) {
     const double eps_at_failure = p.state.plastic_strain;
     const PointResult r = p.step(pure_shear(gamma_dot), dt);
     EXPECT_FALSE(r.failed_now);
+    EXPECT_EQ(r.plastic_strain_rate, 0.0);
     EXPECT_EQ(von_mises(p.state.deviatoric_stress), 0.0);
     EXPECT_EQ(p.state.plastic_strain, eps_at_failure);
     EXPECT_EQ(r.plastic_work, 0.0);
@@ -137,12 +171,18 @@ TEST(Damage, UsesTriaxialityFromPressureAndVonMisesStress) {
     p.density = 0.99 * m.density;
     p.state.pressure = std::get<LinearEos>(m.eos).bulk_modulus * -0.01;
     const double gamma_dot = 1e4, dt = 1e-6;
-    p.step_to(pure_shear(gamma_dot), dt, p.density);
-    ASSERT_GT(p.state.plastic_strain, 0.0);
+    const PointResult r = p.step_to(pure_shear(gamma_dot), dt, p.density);
+    const double d_eps = p.state.plastic_strain;  // from eps_p = 0: the stored value is the increment itself
+    ASSERT_GT(d_eps, 0.0);
     const double sigma_star = -p.state.pressure / von_mises(p.state.deviatoric_stress);
     EXPECT_GT(sigma_star, 1.0);  // 1.4 GPa of tension over ~100 MPa of flow stress
-    const double eps_f = eps_f_closed_form(*m.failure.johnson_cook, sigma_star, gamma_dot / std::sqrt(3.0), 0.0);
-    EXPECT_NEAR(p.state.damage, p.state.plastic_strain / std::max(eps_f, 0.01), kRoundOff * p.state.damage);
+    // eps_f at the step's plastic rate d eps_p / dt (above epsdot0, so D4 acts; below the total rate).
+    const double rate = d_eps / dt;
+    EXPECT_NEAR(r.plastic_strain_rate, rate, kRoundOff * rate);
+    EXPECT_GT(rate, m.failure.johnson_cook->reference_strain_rate);
+    EXPECT_LT(rate, gamma_dot / std::sqrt(3.0));
+    const double eps_f = eps_f_closed_form(*m.failure.johnson_cook, sigma_star, rate, 0.0);
+    EXPECT_NEAR(p.state.damage, d_eps / std::max(eps_f, 0.01), kRoundOff * p.state.damage);
 }
 
 TEST(Damage, TriaxialityIsZeroWhereVonMisesStressVanishes) {
@@ -156,6 +196,7 @@ TEST(Damage, TriaxialityIsZeroWhereVonMisesStressVanishes) {
     p.state.pressure = std::get<LinearEos>(m.eos).bulk_modulus * -0.01;
     const double gamma_dot = 1e3, dt = 1e-7;
     p.step_to(pure_shear(gamma_dot), dt, p.density);
+    // Y = 0: all the trial strain is plastic, so the plastic rate d eps_p / dt is the total gamma_dot / sqrt(3).
     const double rate = gamma_dot / std::sqrt(3.0);
     const double eps_f = (0.05 + 0.05) * (1.0 + 0.01 * std::log(rate)) * (1.0 + 0.5);
     ASSERT_GT(p.state.plastic_strain, 0.0);

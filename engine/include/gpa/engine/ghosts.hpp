@@ -39,19 +39,15 @@ public:
     bool empty() const { return planes_.empty(); }
     bool any_lift_off() const;
 
-    // Which real nodes touch each rigid plane (bit p of NodeStore::plane_contact). At the start,
-    // every node within 3/4 of its diameter of the plane; later, a free node comes into contact
-    // when it is that close and moving towards the plane. On a lift-off plane a node in contact
-    // is released when its normal stress sigma_nn (with viscosity) turns tensile; on a
-    // no-lift-off plane it stays. Decided before the neighbour lists, so that the gradient and
-    // the forces see the same ghost pairs (and the energy identity holds).
+    // Which real nodes touch each lift-off plane (bit p of NodeStore::plane_contact); only they
+    // are paired with its ghosts. At the start, every node within 3/4 of its diameter of the
+    // plane; later, a free node comes into contact when it is that close and moving towards the
+    // plane, and a node in contact is released when its normal stress sigma_nn (with viscosity)
+    // turns tensile. Decided before the neighbour lists, so that the gradient and the forces see
+    // the same ghost pairs (and the energy identity holds). (A rigid plane without lift-off is,
+    // as spec section 7 says, a symmetry plane: its ghost pairs always act.)
     void update_contacts(NodeStore& nodes, std::size_t real_count, bool initial) const;
 
-    // The sliding condition of rigid planes (the paper's "nodes on the rigid surface"): a node in
-    // contact loses its normal velocity towards the plane, and on a no-lift-off plane also away
-    // from it. Returns the kinetic energy removed (J) and adds the momentum removed to
-    // `impulse[p]` (normal component, per plane).
-    double constrain_contact_velocities(NodeStore& nodes, std::size_t real_count, std::vector<double>& impulse) const;
 
     // Replaces the ghosts of `nodes` (everything after real_count) with the mirrors of the real
     // nodes within `range` of the planes (all planes of a corner mask) and of every node that a
@@ -93,7 +89,6 @@ private:
     std::vector<NodeIndex> source_;
     std::vector<std::uint8_t> mask_;
     std::uint8_t lift_off_mask_ = 0;  // bits of the lift-off planes
-    std::uint8_t rigid_mask_ = 0;     // bits of the rigid planes (lift-off or not)
     CompressedRows resolved_;
     std::size_t mask_slot(std::uint8_t mask) const;
     // True when real node i may have (or be paired with) ghosts across the planes of `mask`.

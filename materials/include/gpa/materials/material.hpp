@@ -145,7 +145,7 @@ struct PointResult {
     double sound_speed = 0.0;       // longitudinal, sqrt((K_s + 4 G / 3) / rho), G = 0 when failed or molten
     double plastic_work = 0.0;      // increment of specific plastic work over the step, J/kg
     double viscous_work = 0.0;      // increment of specific work done by Q over the step, J/kg (>= 0 in compression)
-    double plastic_strain_rate = 0.0;  // the rate the strength model saw, 1/s
+    double plastic_strain_rate = 0.0;  // equivalent plastic strain rate d eps_p / dt of the step, 1/s
     bool failed_now = false;        // the node failed during this step
 };
 
