@@ -48,7 +48,8 @@ void paper_lattice() {
     const auto sigma = cauchy_stress<PlaneStrain>(f.deviatoric_stress, f.pressure, nullptr, i);
     const Vec<2> alpha(n.alpha[0][i], n.alpha[1][i]);
     const auto push = [&](std::size_t j) {
-        return pair_force(f.pairs.pair<GpaWeight>(i, j), n.volume[i], n.size_weight[j], alpha, sigma, 0.0)[1];
+        const auto p = f.pairs.pair<GpaWeight>(i, j);
+        return pair_force(p, n.volume[i], n.size_weight[j], alpha.cwiseProduct(p.l).eval(), sigma, 0.0)[1];
     };
     fmt::print("The paper's lattice (plane strain, d = A = 1, a = 1, sigma_z = -1), interior node:\n");
     fmt::print("  neighbours {:d}, alpha_z = {:.4f} (paper 0.6306)\n", lists.row_size(i), n.alpha[1][i]);

@@ -71,11 +71,16 @@ struct Evaluated {
 };
 
 template <class G>
-Evaluated<G> evaluate(const ForceCase& s, const BondViscosityParameters* bond) {
+Evaluated<G> evaluate(const ForceCase& s, const BondViscosityParameters* bond, bool full_normalisation = false) {
     Evaluated<G> e{random_body(s), {}, {}};
     e.lists = find_neighbours(e.nodes, a, e.nodes.size());
-    compute_velocity_gradient<G>(e.lists, s.weight, gradient_fields<G::dim>(e.nodes, a));
+    auto g = gradient_fields<G::dim>(e.nodes, a);
+    g.full_normalisation = full_normalisation;
+    compute_velocity_gradient<G>(e.lists, s.weight, g);
     auto f = force_fields<G::dim>(e.nodes, a);
+    if (full_normalisation) {
+        for (int c = 0; c < (G::dim == 3 ? 3 : 1); ++c) f.alpha_shear[c] = e.nodes.alpha_shear[c].data();
+    }
     e.bond_power.assign(e.nodes.size(), 0.0);
     f.bond_viscous_power = e.bond_power.data();
     if (bond) f.viscous_pressure = nullptr;  // bond viscosity replaces the nodal one
@@ -119,9 +124,9 @@ TEST_P(Conservation, PairForcesConserveMomentum) {
 // sum_i F_i . v_i = - sum_i V_i sigma_i : D_i (- V_i sigma_theta u_i / x_i), and with bond
 // viscosity the difference is the bond term of spec section 5, computed here independently.
 template <class G>
-void check_energy(const ForceCase& s, const BondViscosityParameters* bond) {
+void check_energy(const ForceCase& s, const BondViscosityParameters* bond, bool full_normalisation = false) {
     constexpr int D = G::dim;
-    auto e = evaluate<G>(s, bond);
+    auto e = evaluate<G>(s, bond, full_normalisation);
     const auto& n = e.nodes;
     double force_power = 0.0, stress_power = 0.0, scale = 0.0;
     for (std::size_t i = 0; i < n.size(); ++i) {
@@ -163,12 +168,25 @@ void check_energy(const ForceCase& s, const BondViscosityParameters* bond) {
                     r2 += dx * dx;
                 }
                 const double r = std::sqrt(r2);
+                Eigen::Matrix<double, D, 1> l, dv;
                 for (int c = 0; c < D; ++c) {
-                    const double l = (n.position[c][j] - n.position[c][i]) / r;
-                    const double dv = n.velocity[c][j] - n.velocity[c][i];
-                    dvdx += dv * (n.position[c][j] - n.position[c][i]);
-                    al_dv += n.alpha[c][i] * l * dv;
+                    l[c] = (n.position[c][j] - n.position[c][i]) / r;
+                    dv[c] = n.velocity[c][j] - n.velocity[c][i];
+                    dvdx += dv[c] * (n.position[c][j] - n.position[c][i]);
                 }
+                // alpha_b l_b, or M^-1 l with the full normalisation
+                Eigen::Matrix<double, D, D> N = Eigen::Matrix<double, D, D>::Zero();
+                for (int c = 0; c < D; ++c) N(c, c) = n.alpha[c][i];
+                if (full_normalisation) {
+                    if constexpr (D == 2) {
+                        N(0, 1) = N(1, 0) = n.alpha_shear[0][i];
+                    } else {
+                        N(1, 2) = N(2, 1) = n.alpha_shear[0][i];
+                        N(0, 2) = N(2, 0) = n.alpha_shear[1][i];
+                        N(0, 1) = N(1, 0) = n.alpha_shear[2][i];
+                    }
+                }
+                al_dv = (N * l).dot(dv);
                 const double h = a * 0.5 * (n.diameter[i] + n.diameter[j]);
                 double R = 0.0;
                 if (s.connectivity == Connectivity::Fixed) {
@@ -197,6 +215,15 @@ void check_energy(const ForceCase& s, const BondViscosityParameters* bond) {
 TEST_P(Conservation, ForcePowerEqualsMinusStressPower) {
     const ForceCase s = GetParam();
     dispatch_geometry(s.geometry, [&](auto g) { check_energy<decltype(g)>(s, nullptr); });
+}
+
+TEST_P(Conservation, WithTheMomentMatrixNormalisationTooWithAndWithoutBondViscosity) {
+    const ForceCase s = GetParam();
+    const BondViscosityParameters bond{0.2, 4.0, 0.01};
+    dispatch_geometry(s.geometry, [&](auto g) {
+        check_energy<decltype(g)>(s, nullptr, true);
+        check_energy<decltype(g)>(s, &bond, true);
+    });
 }
 
 TEST_P(Conservation, WithBondViscosityTheDifferenceIsTheBondTerm) {

@@ -212,3 +212,52 @@ INSTANTIATE_TEST_SUITE_P(AllGeometriesAndWeights, Patch, ::testing::ValuesIn(all
 
 }  // namespace
 }  // namespace gpa
+
+namespace gpa {
+namespace {
+
+// The full moment-matrix normalisation (spec section 7) is exact for every affine field on any
+// neighbourhood whose moment matrix is invertible: here every node of a jittered lattice,
+// edges and corners included.
+TEST(PatchMomentMatrix, WholeGradientIsExactEverywhereOnAJitteredLattice) {
+    for (auto g : {GeometryKind::PlaneStrain, GeometryKind::Axisymmetric, GeometryKind::ThreeD}) {
+        dispatch_geometry(g, [&](auto tag) {
+            using G = decltype(tag);
+            constexpr int D = G::dim;
+            testing::LatticeOptions o;
+            o.geometry = g;
+            o.cells = D == 3 ? 7 : 12;
+            o.spacing = 0.5;
+            NodeStore nodes = testing::make_lattice(o);
+            testing::jitter(nodes, 0.2, o.spacing, 21);
+            std::mt19937_64 rng(8);
+            std::uniform_real_distribution<double> u(-1.0, 1.0);
+            Eigen::Matrix<double, D, D> grad;
+            for (int a = 0; a < D; ++a) {
+                for (int b = 0; b < D; ++b) grad(a, b) = u(rng);
+            }
+            for (std::size_t i = 0; i < nodes.size(); ++i) {
+                for (int a = 0; a < D; ++a) {
+                    double v = 0.3;
+                    for (int b = 0; b < D; ++b) v += grad(a, b) * nodes.position[b][i];
+                    nodes.velocity[a][i] = v;
+                }
+            }
+            const auto lists = find_neighbours(nodes, 1.0, nodes.size());
+            auto f = gradient_fields<D>(nodes, 1.0);
+            f.full_normalisation = true;
+            compute_velocity_gradient<G>(lists, WeightKind::Gpa, f);
+            for (std::size_t i = 0; i < nodes.size(); ++i) {
+                for (int a = 0; a < D; ++a) {
+                    for (int b = 0; b < D; ++b) {
+                        ASSERT_NEAR(nodes.velocity_gradient[a * D + b][i], grad(a, b), 1e-12 * grad.norm())
+                            << name_of(g) << " node " << i << " L_" << a << b;
+                    }
+                }
+            }
+        });
+    }
+}
+
+}  // namespace
+}  // namespace gpa

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <limits>
 
+#include <Eigen/Eigenvalues>
 #include <fmt/format.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -78,7 +79,7 @@ template <class G, class W>
     throw NumericalError(fmt::format("{}: the velocity gradient is not finite", describe(f.pairs, i)));
 }
 
-template <class G, class W>
+template <class G, class W, bool full>
 void gradient_impl(const CompressedRows& lists, const GradientFields<G::dim>& f, std::size_t n) {
     constexpr int D = G::dim;
     std::atomic<std::size_t> first_bad{no_node};
@@ -90,32 +91,60 @@ void gradient_impl(const CompressedRows& lists, const GradientFields<G::dim>& f,
             for (NodeIndex j : lists.row(i)) {
                 const auto p = f.pairs.template pair<W>(i, j);
                 ok &= p.r > 0.0;
-                accumulate_gradient(p, f.size_weight[j], (load<D>(f.velocity, j) - v_i).eval(), sums);
+                accumulate_gradient<D, full>(p, f.size_weight[j], (load<D>(f.velocity, j) - v_i).eval(), sums);
             }
-            // Eq. 14-15, 51-53: alpha_b = 1 / sum_j R W l_b^2.
-            Vec<D> alpha = sums.moment.cwiseInverse();
-            if (f.alpha_limit > 0.0) alpha = alpha.cwiseMin(f.alpha_limit / f.size_weight[i]);
-            for (int b = 0; b < D; ++b) ok &= sums.moment[b] > 0.0;
-            const Mat<D> L = velocity_gradient(sums, alpha);
-            ok &= L.allFinite();
+            Mat<D> normalisation;
+            if constexpr (full) {
+                // Spec section 7: N = M^-1, with M's eigenvalues held at or above W_i / alpha_limit.
+                Mat<D> m = sums.moment_matrix;
+                Eigen::SelfAdjointEigenSolver<Mat<D>> eigen;
+                eigen.computeDirect(m, Eigen::EigenvaluesOnly);
+                double smallest = eigen.eigenvalues()(0);
+                if (f.alpha_limit > 0.0) {
+                    const double floor = f.size_weight[i] / f.alpha_limit;
+                    if (smallest < floor) {
+                        m += (floor - smallest) * Mat<D>::Identity();
+                        smallest = floor;
+                    }
+                }
+                ok &= smallest > 0.0;
+                normalisation = m.inverse();
+            } else {
+                // Eq. 14-15, 51-53: alpha_b = 1 / sum_j R W l_b^2.
+                Vec<D> alpha = sums.moment.cwiseInverse();
+                for (int b = 0; b < D; ++b) ok &= sums.moment[b] > 0.0;
+                if (f.alpha_limit > 0.0) alpha = alpha.cwiseMin(f.alpha_limit / f.size_weight[i]);
+                normalisation = alpha.asDiagonal();
+            }
+            const Mat<D> L = velocity_gradient(sums, normalisation);
+            ok &= L.allFinite() && normalisation.allFinite();
             if (!ok) {
                 record_smallest(first_bad, i);
                 continue;
             }
-            for (int b = 0; b < D; ++b) f.alpha[b][i] = alpha[b];
+            for (int b = 0; b < D; ++b) f.alpha[b][i] = normalisation(b, b);
+            if constexpr (full) {
+                if constexpr (D == 2) {
+                    f.alpha_shear[0][i] = normalisation(0, 1);
+                } else {
+                    f.alpha_shear[0][i] = normalisation(1, 2);
+                    f.alpha_shear[1][i] = normalisation(0, 2);
+                    f.alpha_shear[2][i] = normalisation(0, 1);
+                }
+            }
             for (int a = 0; a < D; ++a) {
                 for (int b = 0; b < D; ++b) f.velocity_gradient[a * D + b][i] = L(a, b);
             }
             f.volumetric_strain_rate[i] = volumetric_strain_rate<G>(L, v_i[0], f.pairs.position[0][i]);
             f.smallest_h[i] = sums.smallest_h;
             f.smallest_distance[i] = sums.smallest_distance;
-            if (f.stable_length) f.stable_length[i] = stable_length(sums, alpha);
+            if (f.stable_length) f.stable_length[i] = stable_length(sums, normalisation);
         }
     });
     if (const std::size_t bad = first_bad.load(); bad != no_node) report_gradient_failure<G, W>(lists, f, bad);
 }
 
-template <class G, class W, bool with_bond_viscosity>
+template <class G, class W, bool with_bond_viscosity, bool full>
 void forces_impl(const CompressedRows& lists, const ScatterPlan& plan, const BondViscosityParameters& bond,
                  const ForceFields<G::dim>& f, std::size_t node_count) {
     constexpr int D = G::dim;
@@ -129,6 +158,8 @@ void forces_impl(const CompressedRows& lists, const ScatterPlan& plan, const Bon
     const auto centre = [&](std::size_t i) {
         const Mat<D> sigma = cauchy_stress<G>(f.deviatoric_stress, f.pressure, f.viscous_pressure, i);
         const Vec<D> alpha = load<D>(f.alpha, i);
+        [[maybe_unused]] Mat<D> normalisation;
+        if constexpr (full) normalisation = normalisation_of<D>(f.alpha, f.alpha_shear, i);
         const double volume = f.volume[i];
         Vec<D> on_centre = Vec<D>::Zero();
         [[maybe_unused]] Vec<D> v_i;
@@ -147,12 +178,18 @@ void forces_impl(const CompressedRows& lists, const ScatterPlan& plan, const Bon
                 const double mu = bond_compression_rate(p, dv, bond.eps0);  // Eq. 38
                 q = bond_viscosity(mu, density, sound_speed, bond.linear, bond.quadratic);  // Eq. 37
             }
-            const Vec<D> force_on_j = pair_force(p, volume, f.size_weight[j], alpha, sigma, q);  // Eq. 21-22
+            Vec<D> normalised_l;
+            if constexpr (full) {
+                normalised_l = normalisation * p.l;  // spec section 7: M_i^-1 l
+            } else {
+                normalised_l = alpha.cwiseProduct(p.l);  // alpha_b l_b
+            }
+            const Vec<D> force_on_j = pair_force(p, volume, f.size_weight[j], normalised_l, sigma, q);  // Eq. 21-22
             for (int c = 0; c < D; ++c) f.force[c][j] += force_on_j[c];
             on_centre -= force_on_j;  // Eq. 23-24
             if constexpr (with_bond_viscosity) {
                 // The work rate of the -Q_ij part of this pair's force (spec section 5).
-                bond_power += p.R * volume * f.size_weight[j] * q / p.r * alpha.cwiseProduct(p.l).dot(dv);
+                bond_power += p.R * volume * f.size_weight[j] * q / p.r * normalised_l.dot(dv);
             }
         }
         if constexpr (G::axisymmetric) {
@@ -184,7 +221,13 @@ template <class G>
 void compute_velocity_gradient(const CompressedRows& lists, WeightKind weight, const GradientFields<G::dim>& f,
                                std::size_t centres) {
     const std::size_t n = std::min(centres, lists.rows());
-    dispatch_weight(weight, [&](auto w) { gradient_impl<G, decltype(w)>(lists, f, n); });
+    dispatch_weight(weight, [&](auto w) {
+        if (f.full_normalisation) {
+            gradient_impl<G, decltype(w), true>(lists, f, n);
+        } else {
+            gradient_impl<G, decltype(w), false>(lists, f, n);
+        }
+    });
 }
 
 template <class G>
@@ -197,10 +240,15 @@ void compute_forces(const CompressedRows& lists, const ScatterPlan& plan, Weight
     const BondViscosityParameters none{};
     dispatch_weight(weight, [&](auto w) {
         using W = decltype(w);
-        if (bond) {
-            forces_impl<G, W, true>(lists, plan, *bond, f, node_count);
+        const bool full = f.alpha_shear[0] != nullptr;
+        if (bond && full) {
+            forces_impl<G, W, true, true>(lists, plan, *bond, f, node_count);
+        } else if (bond) {
+            forces_impl<G, W, true, false>(lists, plan, *bond, f, node_count);
+        } else if (full) {
+            forces_impl<G, W, false, true>(lists, plan, none, f, node_count);
         } else {
-            forces_impl<G, W, false>(lists, plan, none, f, node_count);
+            forces_impl<G, W, false, false>(lists, plan, none, f, node_count);
         }
     });
 }

@@ -45,6 +45,7 @@ GradientFields<D> gradient_fields(NodeStore& nodes, double influence_distance) {
         g.alpha[c] = nodes.alpha[c].data();
     }
     for (int c = 0; c < D * D; ++c) g.velocity_gradient[c] = nodes.velocity_gradient[c].data();
+    for (int c = 0; c < (D == 3 ? 3 : 1); ++c) g.alpha_shear[c] = nodes.alpha_shear[c].data();
     g.size_weight = nodes.size_weight.data();
     g.volumetric_strain_rate = nodes.volumetric_strain_rate.data();
     g.smallest_h = nodes.smallest_h.data();

@@ -191,6 +191,21 @@ void GhostSet::refresh(NodeStore& nodes, std::size_t real_count) const {
             }
             for (int c = 0; c < comps; ++c) nodes.deviatoric_stress[c][g] = stress[c];
             for (int c = 0; c < dim; ++c) nodes.alpha[c][g] = nodes.alpha[c][s];
+            // The off-diagonal normalisation mirrors like the shear stresses.
+            std::array<double, 6> shear{};
+            if (dim == 2) {
+                shear[2] = nodes.alpha_shear[0][s];
+            } else {
+                for (int c = 0; c < 3; ++c) shear[3 + c] = nodes.alpha_shear[c][s];
+            }
+            for (std::size_t p = 0; p < planes_.size(); ++p) {
+                if ((mask_[k] >> p) & 1u) mirror_stress(dim, planes_[p].axis, shear);
+            }
+            if (dim == 2) {
+                nodes.alpha_shear[0][g] = shear[2];
+            } else {
+                for (int c = 0; c < 3; ++c) nodes.alpha_shear[c][g] = shear[3 + c];
+            }
             nodes.pressure[g] = nodes.pressure[s];
             nodes.viscous_pressure[g] = nodes.viscous_pressure[s];
             nodes.sound_speed[g] = nodes.sound_speed[s];

@@ -34,6 +34,7 @@ void NodeStore::for_each_field(F&& f) {
         f(force[c]);
     }
     for (int c = 0; c < d * d; ++c) f(velocity_gradient[c]);
+    for (int c = 0; c < (d == 3 ? 3 : 1); ++c) f(alpha_shear[c]);
     for (int c = 0; c < stress_components(d); ++c) f(deviatoric_stress[c]);
     f(mass);
     f(volume);

@@ -264,6 +264,9 @@ void check_solver(const SolverOptions& s) {
     if (!(s.bond_viscosity_eps0 > 0.0 && finite(s.bond_viscosity_eps0))) {
         fail(fmt::format("solver.bond_viscosity_eps0 = {} must be a positive number", s.bond_viscosity_eps0));
     }
+    if (s.normalisation != Normalisation::PerDirection && s.normalisation != Normalisation::MomentMatrix) {
+        fail("solver.normalisation: unknown normalisation");
+    }
     if (s.smoothing != SmoothingMode::Off && s.smoothing != SmoothingMode::Everywhere &&
         s.smoothing != SmoothingMode::Tension) {
         fail("solver.smoothing: unknown smoothing mode");

@@ -248,6 +248,7 @@ template <class G>
 void Simulation::Impl::gradient() {
     auto f = gradient_fields<G::dim>(nodes, a());
     f.alpha_limit = scene.solver.alpha_limit;
+    f.full_normalisation = scene.solver.normalisation == Normalisation::MomentMatrix;
     compute_velocity_gradient<G>(lists, scene.solver.weight, f, real);
 }
 
@@ -308,6 +309,9 @@ template <class G>
 void Simulation::Impl::forces() {
     auto f = force_fields<G::dim>(nodes, a());
     f.hoop_count = real;
+    if (scene.solver.normalisation == Normalisation::MomentMatrix) {
+        for (int c = 0; c < (G::dim == 3 ? 3 : 1); ++c) f.alpha_shear[c] = nodes.alpha_shear[c].data();
+    }
     BondViscosityParameters bond{scene.solver.viscosity_linear, scene.solver.viscosity_quadratic, scene.solver.bond_viscosity_eps0};
     const bool with_bond = scene.solver.viscosity == ViscosityKind::Bond;
     if (with_bond) {

@@ -34,7 +34,7 @@ const std::vector<std::string_view> body_keys{
 const std::vector<std::string_view> plane_keys{"name", "kind", "axis", "position", "side", "lift_off"};
 const std::vector<std::string_view> solver_keys{
     "connectivity", "switch_plastic_strain", "influence_distance", "weight",          "viscosity",
-    "viscosity_linear", "viscosity_quadratic", "bond_viscosity_eps0", "smoothing",     "smoothing_coefficient",
+    "normalisation", "viscosity_linear", "viscosity_quadratic", "bond_viscosity_eps0", "smoothing",     "smoothing_coefficient",
     "cfl",          "alpha_limit",           "max_time_step",      "time_step_growth", "failure",
     "scatter",      "reorder_interval",
 };
@@ -309,6 +309,10 @@ SolverOptions read_solver(const Reporter& reporter, const toml::table& table) {
     if (const auto v = r.quantity("influence_distance", D::Dimensionless)) s.influence_distance = *v;
     if (const auto v = r.choice<WeightKind>("weight", {{"gpa", WeightKind::Gpa}, {"sph-nsf", WeightKind::SphNsf}})) {
         s.weight = *v;
+    }
+    if (const auto v = r.choice<Normalisation>("normalisation", {{"per-direction", Normalisation::PerDirection},
+                                                                 {"moment-matrix", Normalisation::MomentMatrix}})) {
+        s.normalisation = *v;
     }
     if (const auto v = r.choice<ViscosityKind>(
             "viscosity", {{"none", ViscosityKind::None}, {"nodal", ViscosityKind::Nodal}, {"bond", ViscosityKind::Bond}})) {

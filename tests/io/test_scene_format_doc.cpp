@@ -55,6 +55,9 @@ std::string word(SmoothingMode s) {
     return s == SmoothingMode::Off ? "\"off\"" : s == SmoothingMode::Everywhere ? "\"everywhere\"" : "\"tension\"";
 }
 std::string word(WeightKind w) { return w == WeightKind::Gpa ? "\"gpa\"" : "\"sph-nsf\""; }
+std::string word(Normalisation n) {
+    return n == Normalisation::PerDirection ? "\"per-direction\"" : "\"moment-matrix\"";
+}
 std::string word(ScatterScheme s) {
     switch (s) {
         case ScatterScheme::Slabs: return "\"slabs\"";
@@ -85,6 +88,7 @@ TEST(SceneFormatDoc, DefaultsAreThoseOfSceneHpp) {
     expect_number(doc, "switch_plastic_strain", s.switch_plastic_strain);
     expect_number(doc, "influence_distance", s.influence_distance);
     expect_word(doc, "weight", word(s.weight));
+    expect_word(doc, "normalisation", word(s.normalisation));
     expect_word(doc, "viscosity", word(s.viscosity));
     expect_number(doc, "viscosity_linear", s.viscosity_linear);
     expect_number(doc, "viscosity_quadratic", s.viscosity_quadratic);
@@ -109,9 +113,9 @@ TEST(SceneFormatDoc, DefaultsAreThoseOfSceneHpp) {
     expect_number(doc, "snapshot_interval", o.snapshot_interval);
     expect_number(doc, "history_every", static_cast<double>(o.history_every));
 
-    // 17 solver options, 3 stop criteria, 3 output options, and no row for an option that does
+    // 18 solver options, 3 stop criteria, 3 output options, and no row for an option that does
     // not exist.
-    EXPECT_EQ(doc.size(), 23u) << "rows in [solver], [stop] and [output] of docs/scene-format.md";
+    EXPECT_EQ(doc.size(), 24u) << "rows in [solver], [stop] and [output] of docs/scene-format.md";
 }
 
 }  // namespace

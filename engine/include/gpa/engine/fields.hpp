@@ -51,8 +51,12 @@ struct GradientFields {
     PairFields<D> pairs;
     std::array<const double*, D> velocity{};
     const double* size_weight = nullptr;  // W_j
+    // The paper's per-direction normalisation (false) or the full moment matrix (true, spec
+    // section 7); with the full one, the off-diagonal entries of M^-1 go to alpha_shear.
+    bool full_normalisation = false;
     // outputs, one value per centre
-    std::array<double*, D> alpha{};
+    std::array<double*, D> alpha{};                 // the diagonal of the normalisation N
+    std::array<double*, 3> alpha_shear{};           // off-diagonal N: 2D xz; 3D yz, xz, xy (full only)
     std::array<double*, D * D> velocity_gradient{};  // L_ab at [a * D + b]
     double* volumetric_strain_rate = nullptr;
     double* smallest_h = nullptr;
@@ -67,6 +71,7 @@ struct ForceFields {
     const double* volume = nullptr;       // V_i
     const double* size_weight = nullptr;  // W_j
     std::array<const double*, D> alpha{};
+    std::array<const double*, 3> alpha_shear{};  // set: the full normalisation (alpha_shear[0] != nullptr)
     std::array<const double*, 6> deviatoric_stress{};
     const double* pressure = nullptr;
     const double* viscous_pressure = nullptr;  // nodal Q_i; nullptr when there is none
@@ -79,6 +84,24 @@ struct ForceFields {
     double* bond_viscous_power = nullptr;  // per centre, optional: the power of its bond-viscous forces
     std::size_t hoop_count = 0;            // centres [0, hoop_count) feel their hoop stress
 };
+
+// The normalisation N of node i: diag(alpha), plus the off-diagonal entries when given.
+template <int D>
+inline Mat<D> normalisation_of(const std::array<const double*, D>& alpha, const std::array<const double*, 3>& shear,
+                               std::size_t i) {
+    Mat<D> n = Mat<D>::Zero();
+    for (int c = 0; c < D; ++c) n(c, c) = alpha[c][i];
+    if (shear[0]) {
+        if constexpr (D == 2) {
+            n(0, 1) = n(1, 0) = shear[0][i];
+        } else {
+            n(1, 2) = n(2, 1) = shear[0][i];
+            n(0, 2) = n(2, 0) = shear[1][i];
+            n(0, 1) = n(1, 0) = shear[2][i];
+        }
+    }
+    return n;
+}
 
 // Cauchy stress sigma = s - (P + Q) I of node i: the in-plane (or full 3D) part.
 template <class G>

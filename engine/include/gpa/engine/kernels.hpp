@@ -30,41 +30,50 @@ struct PairGeometry {
 // Running sums of the gradient gather for one centre node.
 template <int D>
 struct GradientSums {
-    Vec<D> moment = Vec<D>::Zero();     // sum_j R W l_b^2, the inverse of alpha_b (Eq. 14, 15, 51-53)
-    Mat<D> difference = Mat<D>::Zero(); // sum_j R W (v_a(j) - v_a(i)) l_b / r
+    Vec<D> moment = Vec<D>::Zero();        // sum_j R W l_b^2, the inverse of alpha_b (Eq. 14, 15, 51-53)
+    Mat<D> moment_matrix = Mat<D>::Zero(); // sum_j R W l l^T: the full moment matrix (spec section 7)
+    Mat<D> difference = Mat<D>::Zero();    // sum_j R W (v_a(j) - v_a(i)) l_b / r
+    Mat<D> stiffness = Mat<D>::Zero();     // sum_j u u^T, u = R W l / r, for the stable time step
     double smallest_h = INFINITY;
     double smallest_distance = INFINITY;
-    Vec<D> stiffness = Vec<D>::Zero();  // sum_j (R W l_b / r)^2, for the stable time step
 };
 
 // Eq. 7-8, 10-11, 14-15, 42-53: one neighbour's contribution to the geometry factors and to
-// the velocity gradient L_ab = alpha_b sum_j R W (v_a(j) - v_a(i)) l_b / r.
-template <int D>
+// the velocity gradient L_ab = alpha_b sum_j R W (v_a(j) - v_a(i)) l_b / r. With the full
+// normalisation (spec section 7, Randles and Libersky) the whole moment matrix is summed instead.
+template <int D, bool full_normalisation = false>
 inline void accumulate_gradient(const PairGeometry<D>& p, double size_weight_j, const Vec<D>& dv,
                                 GradientSums<D>& sums) {
     const double rw = p.R * size_weight_j;
-    sums.moment += rw * p.l.cwiseProduct(p.l);
+    if constexpr (full_normalisation) {
+        sums.moment_matrix.noalias() += rw * p.l * p.l.transpose();
+    } else {
+        sums.moment += rw * p.l.cwiseProduct(p.l);
+    }
     sums.difference.noalias() += (rw / p.r) * dv * p.l.transpose();
     sums.smallest_h = std::fmin(sums.smallest_h, p.h);
     sums.smallest_distance = std::fmin(sums.smallest_distance, p.r);
-    const Vec<D> g = (rw / p.r) * p.l;
-    sums.stiffness += g.cwiseProduct(g);
+    const Vec<D> u = (rw / p.r) * p.l;
+    sums.stiffness.noalias() += u * u.transpose();
 }
 
 // The length that sets node i's stable time step (spec section 11, made to see degenerate
 // neighbourhoods): a velocity difference to a neighbour changes the node's strain rate by
-// alpha_b R W l_b / r, so its highest frequency is about c sqrt(sum_b alpha_b^2 sum_j (R W l_b / r)^2).
-// This returns c / omega; on a regular 2D lattice with a = 1 it is 1.46 times the spacing, and it
-// shrinks where neighbours crowd together or alpha grows.
+// N R W l / r (N the normalisation: diag(alpha), or M^-1), so its highest frequency is about
+// c sqrt(sum_j |N u_j|^2) = c sqrt(trace(N S N)), S = sum_j u_j u_j^T. This returns c / omega;
+// on a regular 2D lattice with a = 1 it is 1.46 times the spacing, and it shrinks where
+// neighbours crowd together or alpha grows.
 template <int D>
-inline double stable_length(const GradientSums<D>& sums, const Vec<D>& alpha) {
-    return 1.0 / std::sqrt(alpha.cwiseProduct(alpha).dot(sums.stiffness));
+inline double stable_length(const GradientSums<D>& sums, const Mat<D>& normalisation) {
+    return 1.0 / std::sqrt((normalisation * sums.stiffness * normalisation).trace());
 }
 
-// Geometry factors alpha_b = 1 / sum_j R W l_b^2 and L_ab = alpha_b * difference_ab.
+// The velocity gradient L = difference * N: with N = diag(alpha) the paper's per-direction
+// normalisation (Eq. 14-15, 51-53: alpha_b = 1 / sum_j R W l_b^2), with N = M^-1 the full one
+// (spec section 7), exact for every affine field.
 template <int D>
-inline Mat<D> velocity_gradient(const GradientSums<D>& sums, const Vec<D>& alpha) {
-    return sums.difference * alpha.asDiagonal();
+inline Mat<D> velocity_gradient(const GradientSums<D>& sums, const Mat<D>& normalisation) {
+    return sums.difference * normalisation;
 }
 
 // Eq. 12: eps_v_dot = D_xx + D_zz (+ u/x in axisymmetric geometry, Eq. 9) or the trace in 3D.
@@ -76,14 +85,14 @@ inline double volumetric_strain_rate(const Mat<G::dim>& L, double radial_velocit
 }
 
 // Eq. 21-22, 54-56: the force that centre i's stress exerts on neighbour j,
-//   P_a(ij) = - R V_i W_j / r * sum_b alpha_b(i) (sigma_ab(i) - Q_ij delta_ab) l_b.
-// sigma is the in-plane Cauchy stress of i including its nodal viscosity; Q_ij is the bond
-// viscosity (0 without it). The reaction -P(ij) acts on i (Eq. 23-24).
+//   P_a(ij) = - R V_i W_j / r * sum_b alpha_b(i) (sigma_ab(i) - Q_ij delta_ab) l_b,
+// given the normalised direction n = N_i l (alpha o l, or M_i^-1 l with the full normalisation
+// of spec section 7). sigma is the in-plane Cauchy stress of i including its nodal viscosity;
+// Q_ij is the bond viscosity (0 without it). The reaction -P(ij) acts on i (Eq. 23-24).
 template <int D>
 inline Vec<D> pair_force(const PairGeometry<D>& p, double volume_i, double size_weight_j,
-                         const Vec<D>& alpha_i, const Mat<D>& sigma_i, double bond_q) {
-    const Vec<D> scaled_l = alpha_i.cwiseProduct(p.l);
-    return (-p.R * volume_i * size_weight_j / p.r) * (sigma_i * scaled_l - bond_q * scaled_l);
+                         const Vec<D>& normalised_l, const Mat<D>& sigma_i, double bond_q) {
+    return (-p.R * volume_i * size_weight_j / p.r) * (sigma_i * normalised_l - bond_q * normalised_l);
 }
 
 // Eq. 23 (with Eq. 32 read as "+ P_hoop", see spec section 5): the hoop stress of an

@@ -63,6 +63,8 @@ public:
 
     // --- results of the gradient and force phases, rewritten every step ------------------
     std::array<std::vector<double>, 3> alpha;              // geometry factors (Eq. 14, 15, 51-53)
+    std::array<std::vector<double>, 3> alpha_shear;        // off-diagonal normalisation (full only):
+                                                           // 2D xz; 3D yz, xz, xy
     std::array<std::vector<double>, 9> velocity_gradient;  // L_ab at [a * dim + b]
     std::vector<double> volumetric_strain_rate;            // eps_v_dot (Eq. 12), with hoop term
     std::vector<double> smallest_h;                        // min_j h_ij

@@ -28,6 +28,11 @@ enum class ConnectivityMode {
 
 enum class ViscosityKind { None, Nodal, Bond };
 
+enum class Normalisation {
+    PerDirection,  // the paper's geometry factors alpha_b = 1 / sum_j R W l_b^2 (Eq. 14-15, 51-53)
+    MomentMatrix,  // the inverse of the full moment matrix (spec section 7): exact for every affine field
+};
+
 enum class SmoothingMode {
     Off,
     Everywhere,  // every node is a smoothing centre
@@ -84,6 +89,7 @@ struct SolverOptions {
     double switch_plastic_strain = 0.1;  // Automatic: switch at this equivalent plastic strain
     double influence_distance = 1.0;     // a, 0.8-1.5 (Eq. 2)
     WeightKind weight = WeightKind::Gpa;
+    Normalisation normalisation = Normalisation::PerDirection;
     ViscosityKind viscosity = ViscosityKind::Nodal;
     double viscosity_linear = 0.2;     // C_L (Eq. 36, 37)
     double viscosity_quadratic = 4.0;  // C_Q
