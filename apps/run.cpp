@@ -104,9 +104,9 @@ void print_report(const Simulation& sim) {
 int run_scene(const RunOptions& options) {
     const Scene scene = read_scene(options.scene);
     const fs::path output = options.output.value_or(default_output(scene));
-    io::RunFolder folder(output, options.overwrite);
     const auto wall_start = std::chrono::steady_clock::now();
-    Simulation sim(scene, options.threads);
+    Simulation sim(scene, options.threads);  // before the folder: an impossible scene leaves nothing behind
+    io::RunFolder folder(output, options.overwrite);
     if (!options.quiet) {
         spdlog::info("{}: {} nodes, {} thread{}, output in {}", scene.name.empty() ? "scene" : scene.name, sim.real_count(),
                      sim.threads(), sim.threads() == 1 ? "" : "s", folder.partial().string());

@@ -152,3 +152,29 @@ TEST(BadInput, MismatchedPlanIsRejected) {
 
 }  // namespace
 }  // namespace gpa
+
+namespace gpa {
+namespace {
+
+// In a run a fragment may lose its neighbours (fracture, spall): with allow_degenerate the node
+// gets no strain rate and no geometry factor along the missing axes instead of an error.
+TEST(Degenerate, AnIsolatedNodeInARunFliesOn) {
+    auto n = small_lattice(GeometryKind::Axisymmetric);
+    n.position[0][24] = 10.0;  // far from every other node
+    for (std::size_t i = 0; i < n.size(); ++i) n.velocity[0][i] = 3.0;
+    update_size_weights(n, 0, n.size());
+    const auto lists = find_neighbours(n, 1.0, n.size());
+    auto f = gradient_fields<2>(n, 1.0);
+    f.allow_degenerate = true;
+    f.stable_length = n.stable_length.data();
+    compute_velocity_gradient<Axisymmetric>(lists, WeightKind::Gpa, f);
+    EXPECT_EQ(n.alpha[0][24], 0.0);
+    EXPECT_EQ(n.alpha[1][24], 0.0);
+    for (int c = 0; c < 4; ++c) EXPECT_EQ(n.velocity_gradient[c][24], 0.0);
+    EXPECT_DOUBLE_EQ(n.volumetric_strain_rate[24], 3.0 / 10.0);  // the hoop rate u/x alone
+    EXPECT_TRUE(std::isfinite(n.smallest_h[24]));
+    EXPECT_GT(n.alpha[0][12], 0.0) << "the others keep their factors";
+}
+
+}  // namespace
+}  // namespace gpa

@@ -2,6 +2,9 @@
 // on 1, 2 and 4 threads for every plan.
 
 #include <cstring>
+#include <random>
+
+#include "gpa/engine/lattice.hpp"
 
 #include <gtest/gtest.h>
 
@@ -116,6 +119,35 @@ TEST(Colouring, ForcesAreBitIdenticalOnOneTwoAndFourThreads) {
                     });
                 }
             }
+        }
+    }
+}
+
+}  // namespace
+}  // namespace gpa
+
+namespace gpa {
+namespace {
+
+// Regular lattices put centres exactly on slab and cell boundaries (the reach is a whole number
+// of spacings): rounding must not put one in the wrong group.
+TEST(Colouring, RegularLatticesWithRandomOriginsAndSpacingsAreConflictFree) {
+    std::mt19937_64 rng(12);
+    std::uniform_real_distribution<double> spacing(1e-4, 2e-3), origin(-0.05, 0.05);
+    std::uniform_int_distribution<int> cells(6, 30);
+    for (int trial = 0; trial < 4000; ++trial) {
+        NodeStore n(GeometryKind::PlaneStrain);
+        LatticeBlock b;
+        const double dx = spacing(rng);
+        b.spacing = {dx, dx, dx};
+        b.origin = {origin(rng), origin(rng), 0.0};
+        b.last = {cells(rng), cells(rng), 1};
+        b.connectivity = Connectivity::Fixed;
+        fill_lattice(n, b);
+        const auto lists = find_neighbours(n, 1.0, n.size());
+        for (auto s : {ScatterScheme::Slabs, ScatterScheme::Cells}) {
+            ASSERT_TRUE(plan_is_conflict_free(make_plan(s, lists, view(n), n.size()), lists, n.size()))
+                << name_of(s) << " trial " << trial << " dx " << dx;
         }
     }
 }

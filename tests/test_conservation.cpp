@@ -78,9 +78,7 @@ Evaluated<G> evaluate(const ForceCase& s, const BondViscosityParameters* bond, b
     g.full_normalisation = full_normalisation;
     compute_velocity_gradient<G>(e.lists, s.weight, g);
     auto f = force_fields<G::dim>(e.nodes, a);
-    if (full_normalisation) {
-        for (int c = 0; c < (G::dim == 3 ? 3 : 1); ++c) f.alpha_shear[c] = e.nodes.alpha_shear[c].data();
-    }
+    f.full_normalisation = full_normalisation;
     e.bond_power.assign(e.nodes.size(), 0.0);
     f.bond_viscous_power = e.bond_power.data();
     if (bond) f.viscous_pressure = nullptr;  // bond viscosity replaces the nodal one

@@ -115,7 +115,9 @@ ScatterPlan make_slab_plan(const CompressedRows& lists, const PositionView& x) {
     // 2 * reach wide, centres two slabs apart can never write the same node.
     const double reach = pair_reach(lists, x)[axis];
     const double extent = box.hi[axis] - box.lo[axis];
-    double width = 2.0 * reach;
+    // A margin over 2 * reach: a centre on a slab boundary must not be put in the wrong slab by
+    // the rounding of (x - lo) / width.
+    double width = 2.0 * reach * (1.0 + 1e-9) + 1e-12 * extent;
     if (!(width > 0.0) || !std::isfinite(width)) width = extent + 1.0;
     // Wider slabs are always safe; more slabs than centres buy nothing.
     if (extent / width > static_cast<double>(n)) width = extent / static_cast<double>(n);
@@ -133,9 +135,13 @@ ScatterPlan make_cell_plan(const CompressedRows& lists, const PositionView& x) {
     if (n == 0) return make_serial_plan(lists);
     const Box box = centre_box(n, x);
     const auto reach = pair_reach(lists, x);
-    double edge = 0.0;
-    for (int c = 0; c < x.dim; ++c) edge = std::max(edge, reach[c]);
+    double edge = 0.0, extent = 0.0;
+    for (int c = 0; c < x.dim; ++c) {
+        edge = std::max(edge, reach[c]);
+        extent = std::max(extent, box.hi[c] - box.lo[c]);
+    }
     if (!(edge > 0.0)) return make_serial_plan(lists);
+    edge = edge * (1.0 + 1e-9) + 1e-12 * extent;  // margin against rounding at cell boundaries
     // Centres in cells three apart along some axis write disjoint sets when the cell edge is at
     // least the reach. Keep the grid no larger than a few cells per centre.
     std::array<std::size_t, 3> cells{1, 1, 1};

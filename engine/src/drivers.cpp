@@ -95,26 +95,41 @@ void gradient_impl(const CompressedRows& lists, const GradientFields<G::dim>& f,
             }
             Mat<D> normalisation;
             if constexpr (full) {
-                // Spec section 7: N = M^-1, with M's eigenvalues held at or above W_i / alpha_limit.
-                Mat<D> m = sums.moment_matrix;
+                // Spec section 7: N = M^-1. Each eigenvalue of M is held at or above
+                // W_i / alpha_limit (the same bound as on alpha); with allow_degenerate a direction
+                // M does not see gets no normalisation at all.
                 Eigen::SelfAdjointEigenSolver<Mat<D>> eigen;
-                eigen.computeDirect(m, Eigen::EigenvaluesOnly);
-                double smallest = eigen.eigenvalues()(0);
-                if (f.alpha_limit > 0.0) {
-                    const double floor = f.size_weight[i] / f.alpha_limit;
-                    if (smallest < floor) {
-                        m += (floor - smallest) * Mat<D>::Identity();
-                        smallest = floor;
+                eigen.computeDirect(sums.moment_matrix, Eigen::ComputeEigenvectors);
+                Vec<D> lambda = eigen.eigenvalues();
+                const double floor = f.alpha_limit > 0.0 ? f.size_weight[i] / f.alpha_limit : 0.0;
+                Vec<D> inverse;
+                for (int b = 0; b < D; ++b) {
+                    const double l = std::max(lambda[b], floor);
+                    if (l > 0.0) {
+                        inverse[b] = 1.0 / l;
+                    } else {
+                        inverse[b] = 0.0;
+                        ok &= f.allow_degenerate;
                     }
                 }
-                ok &= smallest > 0.0;
-                normalisation = m.inverse();
+                normalisation = eigen.eigenvectors() * inverse.asDiagonal() * eigen.eigenvectors().transpose();
             } else {
                 // Eq. 14-15, 51-53: alpha_b = 1 / sum_j R W l_b^2.
-                Vec<D> alpha = sums.moment.cwiseInverse();
-                for (int b = 0; b < D; ++b) ok &= sums.moment[b] > 0.0;
+                Vec<D> alpha;
+                for (int b = 0; b < D; ++b) {
+                    if (sums.moment[b] > 0.0) {
+                        alpha[b] = 1.0 / sums.moment[b];
+                    } else {
+                        alpha[b] = 0.0;
+                        ok &= f.allow_degenerate;
+                    }
+                }
                 if (f.alpha_limit > 0.0) alpha = alpha.cwiseMin(f.alpha_limit / f.size_weight[i]);
                 normalisation = alpha.asDiagonal();
+            }
+            if (!std::isfinite(sums.smallest_h)) {
+                // No neighbours: h of the node with itself, so that Eq. 36 stays finite.
+                sums.smallest_h = pair_smoothing_length(f.pairs.influence_distance, f.pairs.diameter[i], f.pairs.diameter[i]);
             }
             const Mat<D> L = velocity_gradient(sums, normalisation);
             ok &= L.allFinite() && normalisation.allFinite();
@@ -137,7 +152,6 @@ void gradient_impl(const CompressedRows& lists, const GradientFields<G::dim>& f,
             }
             f.volumetric_strain_rate[i] = volumetric_strain_rate<G>(L, v_i[0], f.pairs.position[0][i]);
             f.smallest_h[i] = sums.smallest_h;
-            f.smallest_distance[i] = sums.smallest_distance;
             if (f.stable_length) f.stable_length[i] = stable_length(sums, normalisation);
         }
     });
@@ -163,7 +177,7 @@ void forces_impl(const CompressedRows& lists, const ScatterPlan& plan, const Bon
         const double volume = f.volume[i];
         Vec<D> on_centre = Vec<D>::Zero();
         [[maybe_unused]] Vec<D> v_i;
-        [[maybe_unused]] double density = 0.0, sound_speed = 0.0, bond_power = 0.0;
+        [[maybe_unused]] double density = 0.0, sound_speed = 0.0, bond_power = 0.0, largest_q = 0.0;
         if constexpr (with_bond_viscosity) {
             v_i = load<D>(f.velocity, i);
             density = f.mass[i] / volume;
@@ -185,6 +199,9 @@ void forces_impl(const CompressedRows& lists, const ScatterPlan& plan, const Bon
                 normalised_l = alpha.cwiseProduct(p.l);  // alpha_b l_b
             }
             const Vec<D> force_on_j = pair_force(p, volume, f.size_weight[j], normalised_l, sigma, q);  // Eq. 21-22
+            if constexpr (with_bond_viscosity) {
+                if (f.largest_bond_viscosity) largest_q = std::max(largest_q, q);
+            }
             for (int c = 0; c < D; ++c) f.force[c][j] += force_on_j[c];
             on_centre -= force_on_j;  // Eq. 23-24
             if constexpr (with_bond_viscosity) {
@@ -201,6 +218,7 @@ void forces_impl(const CompressedRows& lists, const ScatterPlan& plan, const Bon
         for (int c = 0; c < D; ++c) f.force[c][i] += on_centre[c];
         if constexpr (with_bond_viscosity) {
             if (f.bond_viscous_power) f.bond_viscous_power[i] = bond_power;
+            if (f.largest_bond_viscosity) f.largest_bond_viscosity[i] = largest_q;
         }
     };
 
@@ -240,7 +258,8 @@ void compute_forces(const CompressedRows& lists, const ScatterPlan& plan, Weight
     const BondViscosityParameters none{};
     dispatch_weight(weight, [&](auto w) {
         using W = decltype(w);
-        const bool full = f.alpha_shear[0] != nullptr;
+        const bool full = f.full_normalisation;
+        if (full && !f.alpha_shear[0]) throw InputError("compute_forces: the full normalisation needs alpha_shear");
         if (bond && full) {
             forces_impl<G, W, true, true>(lists, plan, *bond, f, node_count);
         } else if (bond) {

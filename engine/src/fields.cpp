@@ -49,7 +49,6 @@ GradientFields<D> gradient_fields(NodeStore& nodes, double influence_distance) {
     g.size_weight = nodes.size_weight.data();
     g.volumetric_strain_rate = nodes.volumetric_strain_rate.data();
     g.smallest_h = nodes.smallest_h.data();
-    g.smallest_distance = nodes.smallest_distance.data();
     g.stable_length = nodes.stable_length.data();
     return g;
 }
@@ -70,6 +69,7 @@ ForceFields<D> force_fields(NodeStore& nodes, double influence_distance) {
     f.viscous_pressure = nodes.viscous_pressure.data();
     f.mass = nodes.mass.data();
     f.sound_speed = nodes.sound_speed.data();
+    for (int c = 0; c < (D == 3 ? 3 : 1); ++c) f.alpha_shear[c] = nodes.alpha_shear[c].data();
     f.hoop_count = nodes.size();
     return f;
 }

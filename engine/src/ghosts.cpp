@@ -94,10 +94,6 @@ std::vector<MirrorPlane> GhostSet::mirror_planes() const {
     return out;
 }
 
-bool GhostSet::any_lift_off() const {
-    return std::any_of(planes_.begin(), planes_.end(), [](const GhostPlane& p) { return p.lift_off; });
-}
-
 std::size_t GhostSet::mask_slot(std::uint8_t mask) const {
     const auto it = std::find(masks_.begin(), masks_.end(), mask);
     if (it == masks_.end()) throw NumericalError(fmt::format("ghost mask {} combines planes with the same normal", mask));

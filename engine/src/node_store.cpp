@@ -55,7 +55,6 @@ void NodeStore::for_each_field(F&& f) {
     f(viscous_work);
     f(failed);
     f(plane_contact);
-    f(smallest_distance);
     f(stable_length);
     f(body);
     f(material);

@@ -8,9 +8,9 @@
 namespace gpa {
 
 // The step's phases are a chain of continue_nodes (each phase depends on the one before):
-//   [move] -> [reorder] -> [ghosts] -> neighbours -> gradient -> stress -> [switching]
-//     -> plan -> time step -> forces -> integrate -> [smoothing] -> totals
-// (bracketed phases only when the scene needs them; see Simulation::build_phase_graph).
+//   move -> [reorder] -> geometry (and ghosts) -> neighbours -> gradient -> stress -> plan
+//     -> time step -> forces -> integrate -> [smoothing] -> [switching] -> totals
+// (bracketed phases only when the scene needs them; see Simulation::Impl::build_phase_graph).
 struct PhaseGraph::Impl {
     tbb::flow::graph graph;
     tbb::flow::broadcast_node<tbb::flow::continue_msg> start{graph};

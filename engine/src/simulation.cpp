@@ -74,6 +74,8 @@ struct Simulation::Impl {
     ScatterPlan plan;
     SmoothingScratch smoothing_scratch;
     std::vector<double> bond_power;
+    std::vector<double> largest_bond_q;  // per centre, the largest Q_ij of its pairs (for the time step)
+    bool failed = false;                 // a phase threw: the state is half-updated
     std::unique_ptr<PhaseGraph> graph;
 
     double time = 0.0;
@@ -82,7 +84,7 @@ struct Simulation::Impl {
     std::size_t steps = 0;
     double node_steps = 0.0;
     double kinetic_half = 0.0;  // kinetic energy of the current half-step velocities
-    double boundary_work = 0.0, bond_work = 0.0;
+    double boundary_work = 0.0;
     std::vector<double> impulse;
     std::vector<double> reaction;
     Totals totals;
@@ -142,6 +144,30 @@ void Simulation::Impl::setup() {
     }
     real = nodes.size();
     validate_nodes(nodes, 0, real);
+    // A fixed-connectivity node meets a plane only through the mirror images of its lattice
+    // neighbours, which exist when the body starts on the plane; a fixed or automatic body that
+    // starts apart from a plane would pass through it.
+    for (std::size_t b = 0; b < scene.bodies.size(); ++b) {
+        if (body_mode[b] == ConnectivityMode::Variable) continue;
+        for (std::size_t k = 0; k < scene.planes.size(); ++k) {
+            const std::size_t bit = planes.size() - scene.planes.size() + k;
+            bool touches = false;
+            for (std::size_t i = 0; i < real && !touches; ++i) {
+                if (nodes.body[i] != static_cast<std::int32_t>(b)) continue;
+                for (std::size_t e = nodes.fixed_mirrors.offsets[i]; e < nodes.fixed_mirrors.offsets[i + 1]; ++e) {
+                    touches |= (nodes.fixed_mirror_planes[e] >> bit) & 1u;
+                }
+            }
+            if (!touches) {
+                throw InputError(fmt::format(
+                    "body \"{}\" uses {} connectivity but does not start on plane \"{}\": fixed nodes meet a plane "
+                    "only through the mirror images of their lattice neighbours; start the body on the plane (its "
+                    "lattice then continues across it) or give it variable connectivity",
+                    scene.bodies[b].name, body_mode[b] == ConnectivityMode::Fixed ? "fixed" : "automatic",
+                    scene.planes[k].name));
+            }
+        }
+    }
     for (const auto& m : scene.materials) materials::validate(m);
     initialise_material_state(nodes, real, scene.materials);
     if (scene.solver.reorder_interval > 0) reorder();
@@ -249,6 +275,7 @@ void Simulation::Impl::gradient() {
     auto f = gradient_fields<G::dim>(nodes, a());
     f.alpha_limit = scene.solver.alpha_limit;
     f.full_normalisation = scene.solver.normalisation == Normalisation::MomentMatrix;
+    f.allow_degenerate = true;  // a fragment that has lost its neighbours flies on (see fields.hpp)
     compute_velocity_gradient<G>(lists, scene.solver.weight, f, real);
 }
 
@@ -290,15 +317,38 @@ void Simulation::Impl::time_step() {
             for (std::size_t i = r.begin(); i != r.end(); ++i) {
                 const double h = nodes.stable_length[i];
                 const double density = nodes.mass[i] / nodes.volume[i];
-                const double speed = nodes.sound_speed[i] + std::sqrt(std::max(nodes.viscous_pressure[i], 0.0) / density);
-                best = std::min(best, h / speed);
+                const double q = std::max(nodes.viscous_pressure[i], largest_bond_q.empty() ? 0.0 : largest_bond_q[i]);
+                const double speed = nodes.sound_speed[i] + std::sqrt(std::max(q, 0.0) / density);
+                const double local = h / speed;
+                // NaN would drop out of a minimum: make it win, and report it below.
+                best = std::isnan(local) ? local : std::min(best, local);
+                if (std::isnan(best)) return best;
             }
             return best;
         },
-        [](double x, double y) { return std::min(x, y); });
+        [](double x, double y) { return std::isnan(x) || std::isnan(y) ? std::nan("") : std::min(x, y); });
+    if (std::isnan(limit)) {
+        for (std::size_t i = 0; i < real; ++i) {
+            const double local = nodes.stable_length[i] / nodes.sound_speed[i];
+            if (std::isnan(local)) {
+                throw NumericalError(fmt::format("node {} at ({:.6g}, {:.6g}) m at t = {:.6g} s: its stable time step is not "
+                                                 "a number (stable length {}, sound speed {}, volume {})",
+                                                 i, nodes.position[0][i], nodes.position[1][i], time,
+                                                 nodes.stable_length[i], nodes.sound_speed[i], nodes.volume[i]));
+            }
+        }
+        throw NumericalError(fmt::format("the stable time step is not a number at t = {} s", time));
+    }
     double dt = scene.solver.cfl * limit;
     if (dt_half > 0.0) dt = std::min(dt, scene.solver.time_step_growth * dt_half);
     dt = std::min(dt, scene.solver.max_time_step);
+    // Land on the end time instead of stepping past it (unless only a sliver would remain).
+    const double end = scene.stop.end_time;
+    if (end > 0.0 && time < end) {
+        const double left = end - time;
+        if (dt > left) dt = left;
+        else if (dt > 0.5 * left) dt = 0.5 * left;
+    }
     if (!(dt > 0.0) || !std::isfinite(dt)) {
         throw NumericalError(fmt::format("the stable time step is {} s at t = {} s (a node has no size or no sound speed)", dt, time));
     }
@@ -309,15 +359,15 @@ template <class G>
 void Simulation::Impl::forces() {
     auto f = force_fields<G::dim>(nodes, a());
     f.hoop_count = real;
-    if (scene.solver.normalisation == Normalisation::MomentMatrix) {
-        for (int c = 0; c < (G::dim == 3 ? 3 : 1); ++c) f.alpha_shear[c] = nodes.alpha_shear[c].data();
-    }
+    f.full_normalisation = scene.solver.normalisation == Normalisation::MomentMatrix;
     BondViscosityParameters bond{scene.solver.viscosity_linear, scene.solver.viscosity_quadratic, scene.solver.bond_viscosity_eps0};
     const bool with_bond = scene.solver.viscosity == ViscosityKind::Bond;
     if (with_bond) {
         f.viscous_pressure = nullptr;
         bond_power.assign(nodes.size(), 0.0);
         f.bond_viscous_power = bond_power.data();
+        largest_bond_q.assign(nodes.size(), 0.0);
+        f.largest_bond_viscosity = largest_bond_q.data();
     }
     compute_forces<G>(lists, plan, scene.solver.weight, with_bond ? &bond : nullptr, f, nodes.size());
     if (!ghosts.empty()) {
@@ -339,19 +389,13 @@ void Simulation::Impl::integrate(double dt_avg) {
     for (std::size_t k = 0; k < reaction.size(); ++k) impulse[k] += reaction[k] * dt_avg;
     if (scene.solver.viscosity == ViscosityKind::Bond) {
         // The work of the bond-viscous forces becomes internal energy of the centre (spec section 5).
-        const double work = tbb::parallel_deterministic_reduce(
-            tbb::blocked_range<std::size_t>(0, real, reduce_grain), 0.0,
-            [&](const tbb::blocked_range<std::size_t>& r, double sum) {
-                for (std::size_t i = r.begin(); i != r.end(); ++i) {
-                    const double heat = -bond_power[i] * dt_avg / nodes.mass[i];
-                    nodes.internal_energy[i] += heat;
-                    nodes.viscous_work[i] += heat;
-                    sum += heat * nodes.mass[i];
-                }
-                return sum;
-            },
-            [](double x, double y) { return x + y; });
-        bond_work += work;
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, real, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
+            for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                const double heat = -bond_power[i] * dt_avg / nodes.mass[i];
+                nodes.internal_energy[i] += heat;
+                nodes.viscous_work[i] += heat;
+            }
+        });
     }
 }
 
@@ -393,7 +437,8 @@ void Simulation::Impl::sum_totals() {
                         const int across = plane->axis == 0 ? 1 : 0;
                         const double x = nodes.position[across][i];
                         acc.footprint_hi = std::max(acc.footprint_hi, x + half);
-                        acc.footprint_lo = std::min(acc.footprint_lo, axisymmetric ? -(x + half) : x - half);
+                        // On the axis of an axisymmetric body the width is twice the radius.
+                        acc.footprint_lo = std::min(acc.footprint_lo, axisymmetric && across == 0 ? -(x + half) : x - half);
                     }
                 }
             }
@@ -442,15 +487,17 @@ void Simulation::Impl::build_phase_graph() {
     graph->add("neighbours", [this] { neighbours(); });
     graph->add("gradient", [this] { gradient<G>(); });
     graph->add("stress", [this] { stress<G>(); });
-    if (std::any_of(body_mode.begin(), body_mode.end(), [](ConnectivityMode m) { return m == ConnectivityMode::Automatic; })) {
-        graph->add("switching", [this] { switching(); });
-    }
     graph->add("plan", [this] { refresh_ghosts_and_plan(); });
     graph->add("time step", [this] { time_step(); });
     graph->add("forces", [this] { forces<G>(); });
     graph->add("integrate", [this] { integrate(0.5 * (dt_half + dt_next)); });
     if (scene.solver.smoothing != SmoothingMode::Off && scene.solver.smoothing_coefficient > 0.0) {
         graph->add("smoothing", [this] { smoothing<G>(); });
+    }
+    // Switching last: a node that switches takes its new rule from the next geometry on, so that
+    // its strain rates and forces always use one rule (spec section 2).
+    if (std::any_of(body_mode.begin(), body_mode.end(), [](ConnectivityMode m) { return m == ConnectivityMode::Automatic; })) {
+        graph->add("switching", [this] { switching(); });
     }
     graph->add("totals", [this] {
         ++steps;
@@ -469,8 +516,16 @@ Simulation::Simulation(Scene scene, int threads) : impl_(std::make_unique<Impl>(
 Simulation::~Simulation() = default;
 
 void Simulation::step() {
+    if (impl_->failed) {
+        throw NumericalError("Simulation::step: an earlier step failed and left the state half-updated");
+    }
     if (finished()) return;
-    impl_->threads.run([this] { impl_->graph->run(); });
+    try {
+        impl_->threads.run([this] { impl_->graph->run(); });
+    } catch (...) {
+        impl_->failed = true;
+        throw;
+    }
 }
 
 bool Simulation::finished() const {

@@ -213,8 +213,11 @@ void write_profile(const fs::path& file, const Simulation& sim) {
     for (int c = 0; c < dim; ++c) {
         if (c != plane->axis) across.push_back(c);
     }
+    // Radii from the axis of an axisymmetric scene, otherwise from the vertical through the nodes'
+    // centroid.
+    const bool axisymmetric = scene.geometry == GeometryKind::Axisymmetric && plane->axis == 1;
     std::array<double, 3> centre{0, 0, 0};
-    if (dim == 3) {
+    if (!axisymmetric) {
         for (std::size_t i = 0; i < count; ++i) {
             for (int c : across) centre[c] += n.position[c][i] / double(count);
         }
@@ -224,18 +227,14 @@ void write_profile(const fs::path& file, const Simulation& sim) {
         mean_d += n.diameter[i] / double(count);
         top = std::max(top, plane->side * (n.position[plane->axis][i] - plane->position) + 0.5 * n.diameter[i]);
     }
-    const double bin = 0.5 * mean_d;
+    const double bin = mean_d;  // one row of nodes: narrower bins hold only inner nodes every other time
     const std::size_t bins = static_cast<std::size_t>(std::ceil(top / bin)) + 1;
     std::vector<double> radius(bins, -1.0);
     for (std::size_t i = 0; i < count; ++i) {
         const double h = plane->side * (n.position[plane->axis][i] - plane->position);
         double r = 0.0;
-        if (dim == 3) {
-            for (int c : across) r += (n.position[c][i] - centre[c]) * (n.position[c][i] - centre[c]);
-            r = std::sqrt(r);
-        } else {
-            r = n.position[across[0]][i];  // x: the radius in axisymmetric geometry
-        }
+        for (int c : across) r += (n.position[c][i] - centre[c]) * (n.position[c][i] - centre[c]);
+        r = std::sqrt(r);
         const auto k = static_cast<std::size_t>(std::clamp(h / bin, 0.0, double(bins - 1)));
         radius[k] = std::max(radius[k], r + 0.5 * n.diameter[i]);
     }

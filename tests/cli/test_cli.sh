@@ -39,6 +39,11 @@ grep -qF "no-such-scene.toml" err.txt || fail "missing file not named: $(cat err
 "$gpa" run --threads -1 "$src/tests/cli/tiny.toml" > /dev/null 2>&1 && fail "negative thread count accepted"
 "$gpa" frobnicate > /dev/null 2>&1 && fail "unknown subcommand accepted"
 
+# A scene that reads but cannot be set up: refused before any output folder is made.
+expect 2 "fixed body apart from the plane" -- "$gpa" run "$src/tests/cli/gap.toml" -o gap -q
+grep -q "does not start on plane" err.txt || fail "gap scene message: $(cat err.txt)"
+[[ -e gap || -e gap.partial ]] && fail "a refused scene left an output folder"
+
 # 3. An existing, non-empty output folder is refused and left as it was.
 mkdir -p keep && echo "precious" > keep/result.txt
 expect 2 "existing output" -- "$gpa" run "$src/tests/cli/tiny.toml" -o keep -q

@@ -60,9 +60,13 @@ struct GradientFields {
     std::array<double*, D * D> velocity_gradient{};  // L_ab at [a * D + b]
     double* volumetric_strain_rate = nullptr;
     double* smallest_h = nullptr;
-    double* smallest_distance = nullptr;
     double* stable_length = nullptr;  // optional (kernels.hpp: stable_length)
     double alpha_limit = 0.0;         // > 0: alpha_b <= alpha_limit / W_i
+    // false: a centre without neighbours, or whose neighbours give no geometry factor along some
+    // axis, is an error (InputError naming it). true (in a run, where fracture and spall leave
+    // fragments): its factor along that axis is 0, so it has no strain rate and exerts no force
+    // along it; a node with no neighbours flies on with the hoop rate u/x alone.
+    bool allow_degenerate = false;
 };
 
 template <int D>
@@ -71,7 +75,8 @@ struct ForceFields {
     const double* volume = nullptr;       // V_i
     const double* size_weight = nullptr;  // W_j
     std::array<const double*, D> alpha{};
-    std::array<const double*, 3> alpha_shear{};  // set: the full normalisation (alpha_shear[0] != nullptr)
+    bool full_normalisation = false;             // read alpha_shear too (spec section 7)
+    std::array<const double*, 3> alpha_shear{};
     std::array<const double*, 6> deviatoric_stress{};
     const double* pressure = nullptr;
     const double* viscous_pressure = nullptr;  // nodal Q_i; nullptr when there is none
@@ -82,10 +87,12 @@ struct ForceFields {
     // outputs
     std::array<double*, D> force{};
     double* bond_viscous_power = nullptr;  // per centre, optional: the power of its bond-viscous forces
+    double* largest_bond_viscosity = nullptr;  // per centre, optional: its largest Q_ij (for the time step)
     std::size_t hoop_count = 0;            // centres [0, hoop_count) feel their hoop stress
 };
 
-// The normalisation N of node i: diag(alpha), plus the off-diagonal entries when given.
+// The normalisation N of node i (Eq. 14-15, 51-53: diag(alpha); spec section 7: M^-1 when the
+// off-diagonal entries are given).
 template <int D>
 inline Mat<D> normalisation_of(const std::array<const double*, D>& alpha, const std::array<const double*, 3>& shear,
                                std::size_t i) {
@@ -103,7 +110,8 @@ inline Mat<D> normalisation_of(const std::array<const double*, D>& alpha, const 
     return n;
 }
 
-// Cauchy stress sigma = s - (P + Q) I of node i: the in-plane (or full 3D) part.
+// Cauchy stress sigma = s - (P + Q) I of node i (spec section 4; Q the nodal viscosity of Eq. 36):
+// the in-plane (or full 3D) part.
 template <class G>
 inline Mat<G::dim> cauchy_stress(const std::array<const double*, 6>& s, const double* pressure,
                                  const double* viscous_pressure, std::size_t i) {
@@ -119,7 +127,8 @@ inline Mat<G::dim> cauchy_stress(const std::array<const double*, 6>& s, const do
     return sigma;
 }
 
-// The out-of-plane (hoop) Cauchy stress of a 2D node, sigma_theta = s_tt - (P + Q).
+// The out-of-plane (hoop) Cauchy stress of a 2D node, sigma_theta = s_tt - (P + Q), used by the
+// hoop term of Eq. 23 (spec section 5).
 inline double out_of_plane_stress(const std::array<const double*, 6>& s, const double* pressure,
                                   const double* viscous_pressure, std::size_t i) {
     return s[3][i] - pressure[i] - (viscous_pressure ? viscous_pressure[i] : 0.0);

@@ -37,7 +37,6 @@ public:
     const std::vector<GhostPlane>& planes() const { return planes_; }
     std::vector<MirrorPlane> mirror_planes() const;
     bool empty() const { return planes_.empty(); }
-    bool any_lift_off() const;
 
     // Which real nodes touch each lift-off plane (bit p of NodeStore::plane_contact); only they
     // are paired with its ghosts. At the start, every node within 3/4 of its diameter of the
@@ -97,8 +96,8 @@ private:
     }
 };
 
-// Mirrors a symmetric stress (NodeStore order) across a plane normal to `axis`: the shear
-// components with exactly one index along the normal change sign.
+// Mirrors a symmetric stress (NodeStore order) across a plane normal to `axis` (spec section 7):
+// the shear components with exactly one index along the normal change sign.
 void mirror_stress(int dim, int axis, std::array<double, 6>& s);
 
 }  // namespace gpa

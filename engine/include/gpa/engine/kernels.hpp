@@ -1,7 +1,7 @@
 #pragma once
 // The pairwise and per-node kernels of the Generalized Particle Algorithm as small pure
-// functions. They see neither threads nor storage: the drivers in gradient.hpp and forces.hpp
-// apply them over the neighbour lists. Equation numbers are those of Johnson, Beissel and Stryk
+// functions. They see neither threads nor storage: the drivers in drivers.hpp apply them over
+// the neighbour lists. Equation numbers are those of Johnson, Beissel and Stryk
 // (Comput. Mech. 25, 2000), restated in shared/spec/gpa-method.md.
 
 #include <cmath>
@@ -35,7 +35,6 @@ struct GradientSums {
     Mat<D> difference = Mat<D>::Zero();    // sum_j R W (v_a(j) - v_a(i)) l_b / r
     Mat<D> stiffness = Mat<D>::Zero();     // sum_j u u^T, u = R W l / r, for the stable time step
     double smallest_h = INFINITY;
-    double smallest_distance = INFINITY;
 };
 
 // Eq. 7-8, 10-11, 14-15, 42-53: one neighbour's contribution to the geometry factors and to
@@ -52,7 +51,6 @@ inline void accumulate_gradient(const PairGeometry<D>& p, double size_weight_j, 
     }
     sums.difference.noalias() += (rw / p.r) * dv * p.l.transpose();
     sums.smallest_h = std::fmin(sums.smallest_h, p.h);
-    sums.smallest_distance = std::fmin(sums.smallest_distance, p.r);
     const Vec<D> u = (rw / p.r) * p.l;
     sums.stiffness.noalias() += u * u.transpose();
 }

@@ -68,7 +68,6 @@ public:
     std::array<std::vector<double>, 9> velocity_gradient;  // L_ab at [a * dim + b]
     std::vector<double> volumetric_strain_rate;            // eps_v_dot (Eq. 12), with hoop term
     std::vector<double> smallest_h;                        // min_j h_ij
-    std::vector<double> smallest_distance;                 // min_j r_ij
     std::vector<double> stable_length;                     // c / omega of the node (kernels.hpp)
     std::array<std::vector<double>, 3> force;              // N (a ring's force in axisymmetric)
 

@@ -118,7 +118,7 @@ struct StopCriteria {
 };
 
 struct OutputOptions {
-    std::size_t snapshots = 20;      // ParaView snapshots over the run (first and last included); 0 = last only
+    std::size_t snapshots = 20;      // ParaView snapshots over the run, first and last included (0 or 1: those two only)
     double snapshot_interval = 0.0;  // s; > 0 overrides `snapshots`
     std::size_t history_every = 10;  // steps between history rows (the last step is always written)
 };

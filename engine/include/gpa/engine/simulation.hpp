@@ -3,11 +3,14 @@
 // phase graph (spec section 11):
 //
 //   x^{n+1} = x^n + dt v^{n+1/2}                          move (and penetration guard)
-//   geometry at x^{n+1}: d, W, ghosts, neighbours, alpha  ghosts, neighbours, gradient
+//   [every reorder_interval steps: nodes in cell order]  reorder
+//   geometry at x^{n+1}: d, W, ghosts, neighbours, alpha  geometry, neighbours, gradient
 //   L from v^{n+1/2}; eps_v, V, sigma^{n+1}, e^{n+1}      stress
-//   dt^{n+3/2} = C_cfl min h / (c + sqrt(Q / rho))        time step
+//   ghost stresses, the scatter plan                      plan
+//   dt^{n+3/2} = C_cfl min l / (c + sqrt(Q / rho))        time step
 //   F^{n+1} from sigma^{n+1}                              forces
 //   v^{n+3/2} = v^{n+1/2} + (dt^{n+1/2} + dt^{n+3/2})/2 F / M   integrate, [smoothing]
+//   fixed -> variable above the plastic-strain threshold  [switching]
 //
 // After step() the positions, stresses and energies are those of t^{n+1}; velocities are the
 // half step ahead (v^{n+3/2}), and the kinetic energy reported for t^{n+1} is the mean of the two
@@ -26,7 +29,7 @@ namespace gpa {
 
 struct PlaneReport {
     std::string name;
-    double reaction = 0.0;  // normal force the plane exerts on the bodies at t^n (N; a ring total in axisymmetric)
+    double reaction = 0.0;  // normal force the plane exerts on the bodies, F^{n+1} of the last step (N; ring total in axisymmetric)
     double impulse = 0.0;   // time integral of the reaction since t = 0 (N s)
 };
 
@@ -42,7 +45,8 @@ struct Totals {
     double initial_kinetic_energy = 0.0;  // J
     double initial_energy = 0.0;   // kinetic + internal at t = 0, J
     double energy_error = 0.0;     // (KE + IE + boundary work - E0) / E0
-    std::array<double, 3> momentum{0, 0, 0};  // kg m/s (axial component meaningful in axisymmetric)
+    std::array<double, 3> momentum{0, 0, 0};  // sum M v^{n+3/2}, kg m/s: half a step ahead, like the impulse
+                                              // (the axial component is the meaningful one in axisymmetric)
     std::vector<PlaneReport> planes;          // rigid planes, scene order
     double length = 0.0;              // max over nodes of (distance from the first rigid plane + d/2), m
     double footprint_diameter = 0.0;  // width of the nodes within d of the first rigid plane, m

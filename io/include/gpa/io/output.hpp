@@ -83,9 +83,9 @@ struct RunSummary {
 void write_summary(const std::filesystem::path& file, const Simulation& sim, const RunSummary& run);
 
 // profile.csv: the outline of the bodies seen from the first rigid plane, for comparing a
-// Taylor specimen with its measured outline: for bins of height above the plane (half a mean
-// node diameter wide), the largest radial extent x + d/2 (2D; in 3D the distance from the
-// vertical through the nodes' centroid, plus d/2). Heights and radii in m. Does nothing
+// Taylor specimen with its measured outline: for bins of height above the plane (one mean node
+// diameter wide), the largest radial extent plus d/2 (axisymmetric: the radius x; otherwise the
+// distance from the vertical through the nodes' centroid). Heights and radii in m. Does nothing
 // without a rigid plane.
 void write_profile(const std::filesystem::path& file, const Simulation& sim);
 
