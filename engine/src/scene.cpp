@@ -58,19 +58,6 @@ bool known_shape(ShapeKind s) {
     return false;
 }
 
-std::string_view shape_word(ShapeKind s) {
-    switch (s) {
-        case ShapeKind::Cylinder: return "cylinder";
-        case ShapeKind::Plate: return "plate";
-        case ShapeKind::Rectangle: return "rectangle";
-        case ShapeKind::Box: return "box";
-        case ShapeKind::Sphere: return "sphere";
-    }
-    return "?";
-}
-
-bool is_round(ShapeKind s) { return s == ShapeKind::Cylinder || s == ShapeKind::Plate || s == ShapeKind::Sphere; }
-
 // The interval a body occupies along an axis (before any node is placed).
 std::pair<double, double> extent(const BodySpec& b, GeometryKind g, int axis) {
     const int dim = dimension_of(g);
@@ -151,7 +138,7 @@ void check_body(const Scene& scene, const BodySpec& b, std::size_t i) {
         }
         if (g == GeometryKind::Axisymmetric && b.origin[0] != 0.0) {
             fail(fmt::format("{}.origin: an axisymmetric {} lies on the axis, so its origin x must be 0 (is {} m)", label,
-                             shape_word(b.shape), b.origin[0]));
+                             name_of(b.shape), b.origin[0]));
         }
     } else {
         for (int k = 0; k < dim; ++k) {
@@ -310,6 +297,19 @@ void check_output(const OutputOptions& o) {
 }
 
 }  // namespace
+
+std::string_view name_of(ShapeKind s) {
+    switch (s) {
+        case ShapeKind::Cylinder: return "cylinder";
+        case ShapeKind::Plate: return "plate";
+        case ShapeKind::Rectangle: return "rectangle";
+        case ShapeKind::Box: return "box";
+        case ShapeKind::Sphere: return "sphere";
+    }
+    return "?";
+}
+
+bool is_round(ShapeKind s) { return s == ShapeKind::Cylinder || s == ShapeKind::Plate || s == ShapeKind::Sphere; }
 
 void validate_scene(const Scene& scene) {
     const GeometryKind g = scene.geometry;

@@ -137,19 +137,6 @@ std::array<double, 3> to_vector3(const std::vector<double>& v) {
     return out;
 }
 
-bool is_round(ShapeKind s) { return s == ShapeKind::Cylinder || s == ShapeKind::Plate || s == ShapeKind::Sphere; }
-
-std::string_view shape_word(ShapeKind s) {
-    switch (s) {
-        case ShapeKind::Cylinder: return "cylinder";
-        case ShapeKind::Plate: return "plate";
-        case ShapeKind::Rectangle: return "rectangle";
-        case ShapeKind::Box: return "box";
-        case ShapeKind::Sphere: return "sphere";
-    }
-    return "?";
-}
-
 // --- bodies ----------------------------------------------------------------------------------
 
 std::array<double, 6> read_initial_stress(const TableReader& body, GeometryKind geometry) {
@@ -217,7 +204,7 @@ BodySpec read_body(const Reporter& reporter, const toml::table& table, std::size
         b.origin = to_vector3(*origin);
     }
 
-    const std::string_view shape_name = shape_word(b.shape);
+    const std::string_view shape_name = name_of(b.shape);
     if (is_round(b.shape)) {
         if (r.has("radius") && r.has("diameter")) r.fail_at("diameter", "give radius or diameter, not both");
         if (const auto radius = r.quantity("radius", D::Length, Limit::Positive)) {

@@ -11,6 +11,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "gpa/engine/colouring.hpp"
@@ -47,6 +48,10 @@ enum class ShapeKind {
     Box,        // 3D: a box from origin to origin + size
     Sphere,     // centre `origin`, `radius` (a disc in plane strain; a sphere on the axis in axisymmetric)
 };
+
+// The scene-file word of a shape ("cylinder", ...), and whether it is round (has a radius).
+std::string_view name_of(ShapeKind s);
+bool is_round(ShapeKind s);
 
 struct BodySpec {
     std::string name;
