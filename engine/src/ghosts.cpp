@@ -180,28 +180,25 @@ void GhostSet::refresh(NodeStore& nodes, std::size_t real_count) const {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, source_.size(), 2048), [&](const tbb::blocked_range<std::size_t>& r) {
         for (std::size_t k = r.begin(); k != r.end(); ++k) {
             const std::size_t g = real_count + k, s = source_[k];
+            // Symmetric tensors in NodeStore order mirror across every plane of the ghost's mask.
+            const auto mirrored = [&](std::array<double, 6> t) {
+                for (std::size_t p = 0; p < planes_.size(); ++p) {
+                    if ((mask_[k] >> p) & 1u) mirror_stress(dim, planes_[p].axis, t);
+                }
+                return t;
+            };
             std::array<double, 6> stress{};
             for (int c = 0; c < comps; ++c) stress[c] = nodes.deviatoric_stress[c][s];
-            for (std::size_t p = 0; p < planes_.size(); ++p) {
-                if ((mask_[k] >> p) & 1u) mirror_stress(dim, planes_[p].axis, stress);
-            }
+            stress = mirrored(stress);
             for (int c = 0; c < comps; ++c) nodes.deviatoric_stress[c][g] = stress[c];
+            // The normalisation is symmetric too: its diagonal (alpha) is unchanged by a mirror,
+            // its off-diagonal entries (alpha_shear) flip like the shear stresses.
             for (int c = 0; c < dim; ++c) nodes.alpha[c][g] = nodes.alpha[c][s];
-            // The off-diagonal normalisation mirrors like the shear stresses.
-            std::array<double, 6> shear{};
-            if (dim == 2) {
-                shear[2] = nodes.alpha_shear[0][s];
-            } else {
-                for (int c = 0; c < 3; ++c) shear[3 + c] = nodes.alpha_shear[c][s];
-            }
-            for (std::size_t p = 0; p < planes_.size(); ++p) {
-                if ((mask_[k] >> p) & 1u) mirror_stress(dim, planes_[p].axis, shear);
-            }
-            if (dim == 2) {
-                nodes.alpha_shear[0][g] = shear[2];
-            } else {
-                for (int c = 0; c < 3; ++c) nodes.alpha_shear[c][g] = shear[3 + c];
-            }
+            const int first_shear = dim == 2 ? 2 : 3, shears = dim == 2 ? 1 : 3;
+            std::array<double, 6> normalisation{};
+            for (int c = 0; c < shears; ++c) normalisation[first_shear + c] = nodes.alpha_shear[c][s];
+            normalisation = mirrored(normalisation);
+            for (int c = 0; c < shears; ++c) nodes.alpha_shear[c][g] = normalisation[first_shear + c];
             nodes.pressure[g] = nodes.pressure[s];
             nodes.viscous_pressure[g] = nodes.viscous_pressure[s];
             nodes.sound_speed[g] = nodes.sound_speed[s];
