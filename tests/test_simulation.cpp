@@ -137,6 +137,107 @@ TEST(Threads, AFullShortRunIsBitIdenticalOnOneAndTwoThreads) {
     }
 }
 
+// Neighbour lists with a skin (SolverOptions::neighbour_skin): every step, the candidates cut to
+// r < 2 h must be exactly the pairs a full search finds (check_neighbour_lists throws otherwise),
+// with fewer searches than steps; and a run must not depend on the skin beyond round-off.
+Scene three_d_cylinder(int radial_cells) {
+    auto scene = testing::armco_cylinder(radial_cells, 40e-6);
+    scene.geometry = GeometryKind::ThreeD;
+    // A quarter of a square bar: a box on the symmetry planes x = 0 and y = 0, which give corner
+    // (edge) ghosts along the z axis, and the anvil z = 0 below.
+    auto& bar = scene.bodies[0];
+    bar.shape = ShapeKind::Box;
+    bar.size = {bar.radius, bar.radius, bar.length};
+    bar.origin = {0.0, 0.0, 0.0};
+    bar.velocity = {0.0, 0.0, -305.0};
+    scene.planes[0].axis = 2;
+    for (int axis : {0, 1}) {
+        PlaneSpec p;
+        p.name = axis == 0 ? "x = 0" : "y = 0";
+        p.kind = PlaneKind::Symmetry;
+        p.axis = axis;
+        p.side = +1;
+        scene.planes.push_back(p);
+    }
+    return scene;
+}
+
+TEST(NeighbourSkin, CutCandidatesEqualAFullSearchEveryStep) {
+    struct Case {
+        const char* name;
+        Scene scene;
+        int steps;
+    };
+    std::vector<Case> cases;
+    cases.push_back({"axisymmetric Taylor bar, variable", testing::armco_cylinder(6, 40e-6), 300});
+    {
+        auto scene = testing::armco_cylinder(6, 40e-6);
+        scene.solver.connectivity = ConnectivityMode::Automatic;  // switching forces searches
+        scene.solver.switch_plastic_strain = 0.05;
+        cases.push_back({"axisymmetric Taylor bar, automatic switching", scene, 300});
+    }
+    {
+        auto scene = testing::elastic_bar_on_plane(1e-3, 12e-3, 4, 100.0);  // lift-off: contacts come and go
+        scene.stop = {};
+        scene.stop.max_steps = 100000;
+        cases.push_back({"elastic bar bouncing off a lift-off plane", scene, 600});
+    }
+    {
+        // Starts 0.5 mm above the plane: no node has a ghost until the bar comes within reach.
+        auto scene = testing::elastic_bar_on_plane(1e-3, 12e-3, 4, 300.0);
+        scene.bodies[0].origin[1] += 0.5e-3;
+        scene.stop = {};
+        scene.stop.max_steps = 100000;
+        cases.push_back({"elastic bar arriving at a lift-off plane", scene, 600});
+    }
+    {
+        auto scene = testing::armco_cylinder(6, 40e-6);
+        scene.solver.reorder_interval = 7;
+        scene.solver.neighbour_skin = 0.4;
+        cases.push_back({"large skin, frequent reordering", scene, 100});
+    }
+    {
+        auto scene = three_d_cylinder(3);
+        scene.solver.connectivity = ConnectivityMode::Automatic;
+        scene.solver.switch_plastic_strain = 0.05;
+        cases.push_back({"3D quarter bar, automatic switching", scene, 150});
+    }
+    for (auto& c : cases) {
+        SCOPED_TRACE(c.name);
+        c.scene.solver.check_neighbour_lists = true;
+        Simulation sim(c.scene, 2);
+        for (int k = 0; k < c.steps && !sim.finished(); ++k) ASSERT_NO_THROW(sim.step()) << "step " << k;
+        const std::size_t searches = sim.totals().neighbour_searches;
+        std::printf("[ measured ] %s: %zu full searches in %zu steps, %zu pairs\n", c.name, searches, sim.steps(),
+                    sim.totals().pairs);
+        EXPECT_LT(searches, sim.steps()) << "the skin should spare some searches";
+        EXPECT_GT(searches, 1u) << "the bar deforms: the candidates must go stale at some point";
+    }
+}
+
+TEST(NeighbourSkin, ARunDoesNotDependOnTheSkinBeyondRoundOff) {
+    auto with = testing::armco_cylinder(6, 40e-6);
+    auto without = with;
+    without.solver.neighbour_skin = 0.0;
+    Simulation a(with, 2), b(without, 2);
+    for (int k = 0; k < 400; ++k) {
+        a.step();
+        b.step();
+    }
+    ASSERT_EQ(a.real_count(), b.real_count());
+    EXPECT_LT(a.totals().neighbour_searches, 200u);
+    EXPECT_EQ(b.totals().neighbour_searches, 401u);  // set-up and every step
+    // The two runs add the same pairs in different orders: they may differ only by round-off,
+    // amplified over 400 steps of plastic flow; 1e-9 of the bar length bounds that with a wide
+    // margin and is far below any difference a missing or extra pair would make (~1e-3).
+    double worst = 0.0;
+    for (std::size_t i = 0; i < a.real_count(); ++i) {
+        for (int c = 0; c < 2; ++c) worst = std::max(worst, std::abs(a.nodes().position[c][i] - b.nodes().position[c][i]));
+    }
+    EXPECT_LT(worst, 1e-9 * 15.2e-3);
+    EXPECT_NEAR(a.totals().plastic_work, b.totals().plastic_work, 1e-9 * b.totals().plastic_work);
+}
+
 TEST(PhaseGraph, HoldsOnlyThePhasesTheSceneNeeds) {
     auto scene = testing::armco_cylinder(4, 1e-6);
     const auto plain = Simulation(scene, 1).phases();

@@ -2,10 +2,12 @@
 
 #include <algorithm>
 #include <bit>
+#include <cmath>
 
 #include <fmt/format.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
 
 #include "gpa/engine/errors.hpp"
 
@@ -77,7 +79,10 @@ void GhostSet::remove_pairs_without_contact(CompressedRows& lists, const NodeSto
         const std::size_t end = lists.offsets[i + 1];
         for (std::size_t e = start; e < end; ++e) {
             const NodeIndex j = lists.indices[e];
-            if (j >= real_count && !allowed(nodes, i, mask_[j - real_count])) continue;
+            if (j >= real_count) {
+                const std::size_t k = j - real_count;
+                if (!allowed(nodes, i, mask_[k]) || !allowed(nodes, source_[k], mask_[k])) continue;
+            }
             lists.indices[out++] = j;
         }
         start = end;
@@ -100,14 +105,16 @@ std::size_t GhostSet::mask_slot(std::uint8_t mask) const {
     return static_cast<std::size_t>(it - masks_.begin());
 }
 
-void GhostSet::build(NodeStore& nodes, std::size_t real_count, double range) {
+void GhostSet::build(NodeStore& nodes, std::size_t real_count, double range, bool keep_between_searches) {
+    keep_between_searches_ = keep_between_searches;
     source_.clear();
     mask_.clear();
+    slot_.clear();
+    sources_sorted_.clear();
     if (planes_.empty()) {
         nodes.resize(real_count);
         return;
     }
-    const int dim = nodes.dim();
     // Which (source, mask) pairs are needed: nodes near all planes of a mask, and both ends of
     // every mirrored lattice pair.
     std::vector<std::vector<std::uint8_t>> needed(masks_.size(), std::vector<std::uint8_t>(real_count, 0));
@@ -116,7 +123,7 @@ void GhostSet::build(NodeStore& nodes, std::size_t real_count, double range) {
         auto& want = needed[slot];
         tbb::parallel_for(tbb::blocked_range<std::size_t>(0, real_count, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
             for (std::size_t i = r.begin(); i != r.end(); ++i) {
-                bool near = allowed(nodes, i, m);
+                bool near = selectable(nodes, i, m);
                 for (std::size_t p = 0; p < planes_.size() && near; ++p) {
                     if ((m >> p) & 1u) near = planes_[p].distance(nodes.position[planes_[p].axis][i]) < range;
                 }
@@ -129,7 +136,7 @@ void GhostSet::build(NodeStore& nodes, std::size_t real_count, double range) {
         for (std::size_t k = nodes.fixed_mirrors.offsets[i]; k < nodes.fixed_mirrors.offsets[i + 1]; ++k) {
             const std::uint8_t m = nodes.fixed_mirror_planes[k];
             const NodeIndex j = nodes.fixed_mirrors.indices[k];
-            if (!allowed(nodes, i, m) || !allowed(nodes, j, m)) continue;
+            if (!selectable(nodes, i, m) || !selectable(nodes, j, m)) continue;
             const std::size_t slot = mask_slot(m);
             needed[slot][j] = 1;
             needed[slot][i] = 1;
@@ -142,10 +149,23 @@ void GhostSet::build(NodeStore& nodes, std::size_t real_count, double range) {
             index_[slot][i] = static_cast<std::int64_t>(real_count + source_.size());
             source_.push_back(static_cast<NodeIndex>(i));
             mask_.push_back(masks_[slot]);
+            slot_.push_back(static_cast<std::uint8_t>(slot));
         }
     }
+    sources_sorted_ = source_;
+    std::sort(sources_sorted_.begin(), sources_sorted_.end());
+    sources_sorted_.erase(std::unique(sources_sorted_.begin(), sources_sorted_.end()), sources_sorted_.end());
+    nodes.resize(real_count + source_.size());
+    update(nodes, real_count);
+    refresh(nodes, real_count);
+}
+
+void GhostSet::update(NodeStore& nodes, std::size_t real_count) const {
+    const int dim = nodes.dim();
     const std::size_t ghosts = source_.size();
-    nodes.resize(real_count + ghosts);
+    if (nodes.size() != real_count + ghosts) {
+        throw NumericalError(fmt::format("GhostSet::update: {} nodes for {} real and {} ghosts", nodes.size(), real_count, ghosts));
+    }
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, ghosts, 2048), [&](const tbb::blocked_range<std::size_t>& r) {
         for (std::size_t k = r.begin(); k != r.end(); ++k) {
             const std::size_t g = real_count + k, s = source_[k];
@@ -171,7 +191,69 @@ void GhostSet::build(NodeStore& nodes, std::size_t real_count, double range) {
             nodes.failed[g] = nodes.failed[s];
         }
     });
-    refresh(nodes, real_count);
+}
+
+bool GhostSet::covers(const NodeStore& nodes, std::size_t real_count, double range) const {
+    if (planes_.empty()) return true;
+    for (std::size_t slot = 0; slot < masks_.size(); ++slot) {
+        const std::uint8_t m = masks_[slot];
+        const auto& index = index_[slot];
+        if (index.size() != real_count) return false;
+        const bool missing = tbb::parallel_reduce(
+            tbb::blocked_range<std::size_t>(0, real_count, 4096), false,
+            [&](const tbb::blocked_range<std::size_t>& r, bool found) {
+                for (std::size_t i = r.begin(); i != r.end() && !found; ++i) {
+                    if (index[i] >= 0 || !selectable(nodes, i, m)) continue;
+                    bool near = true;
+                    for (std::size_t p = 0; p < planes_.size() && near; ++p) {
+                        if ((m >> p) & 1u) near = planes_[p].distance(nodes.position[planes_[p].axis][i]) < range;
+                    }
+                    found = near;
+                }
+                return found;
+            },
+            [](bool x, bool y) { return x || y; });
+        if (missing) return false;
+    }
+    return true;
+}
+
+double GhostSet::mirrored_displacement_bound(const NodeStore& nodes, std::size_t real_count,
+                                             const std::array<std::vector<double>, 3>& reference) const {
+    const int dim = nodes.dim();
+    double bound = 0.0;
+    for (const std::uint8_t m : masks_) {
+        // The middle of the displacements of this combination's sources, normal parts zeroed.
+        std::array<double, 3> lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
+        bool any = false;
+        for (std::size_t k = 0; k < source_.size(); ++k) {
+            if (mask_[k] != m) continue;
+            any = true;
+            for (int c = 0; c < dim; ++c) {
+                const double u = nodes.position[c][source_[k]] - reference[c][source_[k]];
+                lo[c] = std::min(lo[c], u);
+                hi[c] = std::max(hi[c], u);
+            }
+        }
+        if (!any) continue;
+        std::array<double, 3> middle{0, 0, 0};
+        for (int c = 0; c < dim; ++c) middle[c] = 0.5 * (lo[c] + hi[c]);
+        for (std::size_t p = 0; p < planes_.size(); ++p) {
+            if ((m >> p) & 1u) middle[planes_[p].axis] = 0.0;
+        }
+        double largest = 0.0;
+        for (std::size_t k = 0; k < source_.size(); ++k) {
+            if (mask_[k] != m) continue;
+            double u2 = 0.0;
+            for (int c = 0; c < dim; ++c) {
+                const double u = nodes.position[c][source_[k]] - reference[c][source_[k]] - middle[c];
+                u2 += u * u;
+            }
+            largest = std::max(largest, u2);
+        }
+        bound = std::max(bound, 2.0 * std::sqrt(largest));
+    }
+    return bound;
 }
 
 void GhostSet::refresh(NodeStore& nodes, std::size_t real_count) const {
@@ -218,7 +300,7 @@ const CompressedRows& GhostSet::resolved_fixed_mirrors(const NodeStore& nodes, s
         for (std::size_t k = nodes.fixed_mirrors.offsets[i]; fixed && k < nodes.fixed_mirrors.offsets[i + 1]; ++k) {
             const std::uint8_t m = nodes.fixed_mirror_planes[k];
             const NodeIndex j = nodes.fixed_mirrors.indices[k];
-            if (!allowed(nodes, i, m) || !allowed(nodes, j, m)) continue;  // not touching a lift-off plane
+            if (!selectable(nodes, i, m) || !selectable(nodes, j, m)) continue;  // not touching a lift-off plane
             const std::int64_t g = index_[mask_slot(m)][j];
             if (g < 0) throw NumericalError(fmt::format("node {}: its mirrored lattice neighbour has no ghost", i));
             resolved_.indices.push_back(static_cast<NodeIndex>(g));
@@ -233,13 +315,14 @@ void GhostSet::append_ghost_rows(CompressedRows& lists, std::size_t real_count) 
     if (lists.rows() != real_count) {
         throw NumericalError(fmt::format("append_ghost_rows: {} rows for {} real nodes", lists.rows(), real_count));
     }
-    // Ghost centre mirror(s, S) gets real j for every entry mirror(j, S) of s's list.
+    // Ghost centre mirror(s, S) gets real j for every entry mirror(j, S) of s's list. Only a node
+    // with ghosts of its own can list a ghost (it is then within reach of the same planes), so
+    // only those rows are read.
     const auto target = [&](std::size_t s, NodeIndex entry) -> std::int64_t {
-        const std::size_t k = entry - real_count;
-        return index_[mask_slot(mask_[k])][s];
+        return index_[slot_[entry - real_count]][s];
     };
     std::vector<std::size_t> count(ghosts + 1, 0);
-    for (std::size_t s = 0; s < real_count; ++s) {
+    for (const NodeIndex s : sources_sorted_) {
         for (NodeIndex j : lists.row(s)) {
             if (j < real_count) continue;
             const std::int64_t t = target(s, j);
@@ -259,7 +342,7 @@ void GhostSet::append_ghost_rows(CompressedRows& lists, std::size_t real_count) 
     lists.indices.resize(base + count[ghosts]);
     std::vector<std::size_t> next(ghosts);
     for (std::size_t k = 0; k < ghosts; ++k) next[k] = base + count[k];
-    for (std::size_t s = 0; s < real_count; ++s) {
+    for (const NodeIndex s : sources_sorted_) {
         for (std::size_t e = lists.offsets[s]; e < lists.offsets[s + 1]; ++e) {
             const NodeIndex j = lists.indices[e];
             if (j < real_count) continue;

@@ -31,6 +31,12 @@ bool is_pair(const NodeStore& s, double a, std::size_t i, std::size_t j) {
     return within_influence(squared_distance(s, i, j), pair_smoothing_length(a, s.diameter[i], s.diameter[j]));
 }
 
+// r_ij < 2 h_ij + skin: a pair, or one that may become a pair before the next search.
+bool is_candidate(const NodeStore& s, double a, double skin, std::size_t i, std::size_t j) {
+    const double reach = 2.0 * pair_smoothing_length(a, s.diameter[i], s.diameter[j]) + skin;
+    return squared_distance(s, i, j) < reach * reach;
+}
+
 }  // namespace
 
 double largest_interaction_radius(const NodeStore& nodes, double a, std::size_t count) {
@@ -101,8 +107,9 @@ bool needs_search(const NodeStore& nodes, std::size_t centres) {
 }
 
 void find_neighbours(const NodeStore& nodes, double a, std::size_t centres, CompressedRows& out,
-                     NeighbourScratch& scratch, const CompressedRows* extra_fixed) {
+                     NeighbourScratch& scratch, const CompressedRows* extra_fixed, double skin) {
     check_influence_distance(a);
+    if (!(skin >= 0.0) || !std::isfinite(skin)) throw InputError(fmt::format("find_neighbours: skin {} must be a finite length >= 0", skin));
     const std::size_t n = nodes.size();
     if (centres > n) throw InputError(fmt::format("find_neighbours: {} centres of {} nodes", centres, n));
     if (nodes.fixed_neighbours.rows() < centres) {
@@ -113,7 +120,7 @@ void find_neighbours(const NodeStore& nodes, double a, std::size_t centres, Comp
         throw InputError(fmt::format("find_neighbours: extra fixed lists cover {} of {} centres", extra_fixed->rows(), centres));
     }
     const bool search = needs_search(nodes, centres);
-    if (search) scratch.grid.build(nodes, n, largest_interaction_radius(nodes, a, n));
+    if (search) scratch.grid.build(nodes, n, largest_interaction_radius(nodes, a, n) + skin);
     const CellGrid& grid = scratch.grid;
     const int dim = nodes.dim();
 
@@ -154,7 +161,9 @@ void find_neighbours(const NodeStore& nodes, double a, std::size_t centres, Comp
                                 for (std::size_t k = grid.cell_start[cell]; k < grid.cell_start[cell + 1]; ++k) {
                                     const NodeIndex j = grid.nodes[k];
                                     if (j == i || (fixed && nodes.body[j] == own_body)) continue;
-                                    if (is_pair(nodes, a, i, j)) indices.push_back(j);
+                                    if (skin > 0.0 ? is_candidate(nodes, a, skin, i, j) : is_pair(nodes, a, i, j)) {
+                                        indices.push_back(j);
+                                    }
                                 }
                             }
                         }
@@ -181,6 +190,73 @@ void find_neighbours(const NodeStore& nodes, double a, std::size_t centres, Comp
             std::copy(src.begin(), src.end(), out.indices.begin() + out.offsets[b * search_block]);
         }
     });
+}
+
+namespace {
+
+template <int D>
+void filter_rows(const NodeStore& nodes, double a, const CompressedRows& candidates,
+                 const std::vector<std::uint32_t>& unconditional, CompressedRows& out, std::vector<std::uint8_t>& keep) {
+    const std::size_t rows = candidates.rows();
+    std::array<const double*, D> x{};
+    for (int c = 0; c < D; ++c) x[c] = nodes.position[c].data();
+    const double* d = nodes.diameter.data();
+    const NodeIndex* index = candidates.indices.data();
+    // Pass 1: mark the kept entries and count them per row (the counts go to offsets[i + 1]).
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rows, search_block), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+            const std::size_t first = candidates.offsets[i], last = candidates.offsets[i + 1];
+            const std::size_t fixed_end = std::min(last, first + unconditional[i]);
+            std::size_t kept = fixed_end - first;
+            for (std::size_t e = first; e < fixed_end; ++e) keep[e] = 1;
+            std::array<double, D> xi;
+            for (int c = 0; c < D; ++c) xi[c] = x[c][i];
+            const double di = d[i];
+            for (std::size_t e = fixed_end; e < last; ++e) {
+                const NodeIndex j = index[e];
+                double r2 = 0.0;
+                for (int c = 0; c < D; ++c) {
+                    const double dx = x[c][j] - xi[c];
+                    r2 += dx * dx;
+                }
+                // The search's rule, within_influence(r^2, h_ij) (weights.hpp).
+                const bool pair = within_influence(r2, pair_smoothing_length(a, di, d[j]));
+                keep[e] = pair;
+                kept += pair;
+            }
+            out.offsets[i + 1] = kept;
+        }
+    });
+    for (std::size_t i = 0; i < rows; ++i) out.offsets[i + 1] += out.offsets[i];
+    out.indices.resize(out.offsets[rows]);
+    // Pass 2: copy the kept entries in order.
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rows, search_block), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+            std::size_t o = out.offsets[i];
+            for (std::size_t e = candidates.offsets[i]; e < candidates.offsets[i + 1]; ++e) {
+                if (keep[e]) out.indices[o++] = index[e];
+            }
+        }
+    });
+}
+
+}  // namespace
+
+void filter_candidates(const NodeStore& nodes, double a, const CompressedRows& candidates,
+                       const std::vector<std::uint32_t>& unconditional, CompressedRows& out,
+                       std::vector<std::uint8_t>& keep) {
+    const std::size_t rows = candidates.rows();
+    if (unconditional.size() < rows) {
+        throw InputError(fmt::format("filter_candidates: {} unconditional counts for {} rows", unconditional.size(), rows));
+    }
+    keep.resize(candidates.entries());
+    out.offsets.resize(rows + 1);
+    out.offsets[0] = 0;
+    if (nodes.dim() == 2) {
+        filter_rows<2>(nodes, a, candidates, unconditional, out, keep);
+    } else {
+        filter_rows<3>(nodes, a, candidates, unconditional, out, keep);
+    }
 }
 
 CompressedRows find_neighbours(const NodeStore& nodes, double a, std::size_t centres) {

@@ -71,6 +71,19 @@ struct Simulation::Impl {
     CompressedRows lists;
     bool lists_constant = false;  // all fixed, one body, no ghosts: the lists never change
     NeighbourScratch search_scratch;
+    // Verlet lists (SolverOptions::neighbour_skin): candidates within 2 h_ij + skin from the last
+    // search, the positions and diameters then, and which leading entries of a row are kept
+    // whatever the distance (a fixed centre's lattice neighbours and their mirrors).
+    bool with_skin = false;
+    bool search_due = true;
+    bool plan_due = false;  // lists searched without a skin need a new scatter plan
+    double skin = 0.0;
+    std::size_t searches = 0;
+    CompressedRows candidates;
+    std::vector<std::uint32_t> unconditional;
+    std::vector<std::uint8_t> keep_scratch;
+    std::array<std::vector<double>, 3> searched_position;
+    std::vector<double> searched_diameter;
     ScatterPlan plan;
     SmoothingScratch smoothing_scratch;
     std::vector<double> bond_power;
@@ -106,6 +119,9 @@ struct Simulation::Impl {
     template <class G>
     void geometry();
     void neighbours();
+    bool candidates_stale(double range) const;
+    void search_candidates();
+    void check_lists_against_search();
     template <class G>
     void gradient();
     template <class G>
@@ -175,6 +191,7 @@ void Simulation::Impl::setup() {
     lists_constant = ghosts.empty() && !needs_search(nodes, real) &&
                      std::none_of(body_mode.begin(), body_mode.end(),
                                   [](ConnectivityMode m) { return m == ConnectivityMode::Automatic; });
+    with_skin = scene.solver.neighbour_skin > 0.0 && !lists_constant;
 
     // Geometry, neighbours, geometry factors and forces at t = 0; then the first half step.
     geometry<G>();
@@ -207,6 +224,7 @@ void Simulation::Impl::reorder() {
     const double cell = largest_interaction_radius(nodes, a(), real);
     nodes.permute(locality_order(nodes, cell, 0, real));
     lists.clear();  // rebuilt in the new numbering by the neighbours phase
+    search_due = true;
     regroup_materials();
 }
 
@@ -252,14 +270,149 @@ void Simulation::Impl::geometry() {
         }
         update_size_weights(nodes, r.begin(), r.end());
     });
+    const double range = largest_interaction_radius(nodes, a(), real);
+    if (with_skin && !search_due) search_due = candidates_stale(range);
     if (!ghosts.empty()) {
         ghosts.update_contacts(nodes, real, steps == 0 && time == 0.0);
-        ghosts.build(nodes, real, largest_interaction_radius(nodes, a(), real));
+        if (!with_skin) {
+            ghosts.build(nodes, real, range);
+        } else if (search_due) {
+            // Ghosts for every node within the candidates' reach, kept until the next search.
+            skin = scene.solver.neighbour_skin * range;
+            ghosts.build(nodes, real, range + skin, true);
+        } else {
+            ghosts.update(nodes, real);
+        }
     }
+}
+
+bool Simulation::Impl::candidates_stale(double range) const {
+    // A pair (i, j) left out by the last search had r >= 2 h_ij + skin then. Now r has shrunk by
+    // at most |u_i - u_j| <= 2 max |u - U| (u the displacements since the search, U any common
+    // translation: the middle of the u), and 2 h_ij has grown by at most 2 a max (d - d_then).
+    // The candidates are stale once those two can add up to the skin. Pairs with ghosts get the
+    // same bound from the ghost set, which must also still hold every node within reach of a plane.
+    struct Extent {
+        std::array<double, 3> lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
+        double growth = 0.0;
+    };
+    const int d = dim();
+    const Extent e = tbb::parallel_reduce(
+        tbb::blocked_range<std::size_t>(0, real, reduce_grain), Extent{},
+        [&](const tbb::blocked_range<std::size_t>& r, Extent acc) {
+            for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                for (int c = 0; c < d; ++c) {
+                    const double u = nodes.position[c][i] - searched_position[c][i];
+                    acc.lo[c] = std::min(acc.lo[c], u);
+                    acc.hi[c] = std::max(acc.hi[c], u);
+                }
+                acc.growth = std::max(acc.growth, nodes.diameter[i] - searched_diameter[i]);
+            }
+            return acc;
+        },
+        [](Extent x, const Extent& y) {
+            for (int c = 0; c < 3; ++c) {
+                x.lo[c] = std::min(x.lo[c], y.lo[c]);
+                x.hi[c] = std::max(x.hi[c], y.hi[c]);
+            }
+            x.growth = std::max(x.growth, y.growth);
+            return x;
+        });
+    std::array<double, 3> middle{0, 0, 0};
+    for (int c = 0; c < d; ++c) middle[c] = 0.5 * (e.lo[c] + e.hi[c]);
+    const double largest = tbb::parallel_reduce(
+        tbb::blocked_range<std::size_t>(0, real, reduce_grain), 0.0,
+        [&](const tbb::blocked_range<std::size_t>& r, double acc) {
+            for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                double u2 = 0.0;
+                for (int c = 0; c < d; ++c) {
+                    const double u = nodes.position[c][i] - searched_position[c][i] - middle[c];
+                    u2 += u * u;
+                }
+                acc = std::max(acc, u2);
+            }
+            return acc;
+        },
+        [](double x, double y) { return std::max(x, y); });
+    double closing = 2.0 * std::sqrt(largest);
+    if (!ghosts.empty()) {
+        if (!ghosts.covers(nodes, real, range)) return true;
+        closing = std::max(closing, ghosts.mirrored_displacement_bound(nodes, real, searched_position));
+    }
+    // NaN positions make the bound NaN: search, and let the phases report them.
+    return !(closing + 2.0 * a() * e.growth < skin);
+}
+
+void Simulation::Impl::check_lists_against_search() {
+    // The pairs a step without a skin would have: fresh ghosts (only the nodes in contact across
+    // lift-off planes) in a copy of the nodes, a full search, the contact rule. A ghost entry is
+    // compared as (source node, planes), since the two ghost sets number their ghosts differently.
+    NodeStore copy = nodes;
+    GhostSet fresh_ghosts = ghosts;
+    CompressedRows fresh;
+    NeighbourScratch scratch;
+    const CompressedRows* mirrored = nullptr;
+    if (!ghosts.empty()) {
+        fresh_ghosts.build(copy, real, largest_interaction_radius(nodes, a(), real));
+        mirrored = &fresh_ghosts.resolved_fixed_mirrors(copy, real);
+    }
+    find_neighbours(copy, a(), real, fresh, scratch, mirrored);
+    if (!ghosts.empty()) fresh_ghosts.remove_pairs_without_contact(fresh, copy, real);
+    const auto key = [&](const GhostSet& set, NodeIndex j) -> std::uint64_t {
+        if (j < real) return j;
+        const std::size_t k = j - real;
+        return (std::uint64_t{set.planes_of(k)} << 40) | set.source(k);
+    };
+    for (std::size_t i = 0; i < real; ++i) {
+        std::vector<std::uint64_t> mine, theirs;
+        for (NodeIndex j : lists.row(i)) mine.push_back(key(ghosts, j));
+        for (NodeIndex j : fresh.row(i)) theirs.push_back(key(fresh_ghosts, j));
+        std::sort(mine.begin(), mine.end());
+        std::sort(theirs.begin(), theirs.end());
+        if (mine != theirs) {
+            throw NumericalError(fmt::format("step {}: node {} has {} neighbours from the candidate lists but {} from a "
+                                             "full search",
+                                             steps, i, mine.size(), theirs.size()));
+        }
+    }
+}
+
+void Simulation::Impl::search_candidates() {
+    const CompressedRows* mirrored = ghosts.empty() ? nullptr : &ghosts.resolved_fixed_mirrors(nodes, real);
+    if (ghosts.empty()) skin = scene.solver.neighbour_skin * largest_interaction_radius(nodes, a(), real);
+    find_neighbours(nodes, a(), real, candidates, search_scratch, mirrored, skin);
+    unconditional.assign(real, 0);
+    for (std::size_t i = 0; i < real; ++i) {
+        if (nodes.connectivity[i] != Connectivity::Fixed) continue;
+        unconditional[i] = static_cast<std::uint32_t>(nodes.fixed_neighbours.row(i).size() + (mirrored ? mirrored->row(i).size() : 0));
+    }
+    for (int c = 0; c < dim(); ++c) searched_position[c].assign(nodes.position[c].begin(), nodes.position[c].begin() + real);
+    searched_diameter.assign(nodes.diameter.begin(), nodes.diameter.begin() + real);
+    // The scatter plan of the candidates (with their ghost rows) serves every step until the
+    // next search: a plan without conflicts for some lists has none for any subset of them.
+    if (ghosts.empty()) {
+        plan = make_plan(scene.solver.scatter, candidates, positions_of(nodes), nodes.size());
+    } else {
+        CompressedRows with_ghosts = candidates;
+        ghosts.append_ghost_rows(with_ghosts, real);
+        plan = make_plan(scene.solver.scatter, with_ghosts, positions_of(nodes), nodes.size());
+    }
+    search_due = false;
+    ++searches;
 }
 
 void Simulation::Impl::neighbours() {
     if (lists_constant && lists.rows() == real) return;
+    if (with_skin) {
+        if (search_due) search_candidates();
+        filter_candidates(nodes, a(), candidates, unconditional, lists, keep_scratch);
+        if (!ghosts.empty()) ghosts.remove_pairs_without_contact(lists, nodes, real);
+        if (scene.solver.check_neighbour_lists) check_lists_against_search();
+        if (!ghosts.empty()) ghosts.append_ghost_rows(lists, real);
+        return;
+    }
+    ++searches;
+    plan_due = true;
     if (ghosts.empty()) {
         find_neighbours(nodes, a(), real, lists, search_scratch);
         return;
@@ -297,13 +450,18 @@ void Simulation::Impl::switching() {
         if (nodes.connectivity[i] == Connectivity::Fixed && body_mode[static_cast<std::size_t>(nodes.body[i])] == ConnectivityMode::Automatic &&
             nodes.plastic_strain[i] > threshold) {
             nodes.connectivity[i] = Connectivity::Variable;
+            search_due = true;  // its row must be searched under the variable rule
         }
     }
 }
 
 void Simulation::Impl::refresh_ghosts_and_plan() {
     if (!ghosts.empty()) ghosts.refresh(nodes, real);
+    // With a skin the plan comes with the search (search_candidates); lists that did not change
+    // keep theirs (a plan depends on the lists and on the positions it was made from only).
+    if (!plan_due) return;
     plan = make_plan(scene.solver.scatter, lists, positions_of(nodes), nodes.size());
+    plan_due = false;
 }
 
 void Simulation::Impl::time_step() {
@@ -463,6 +621,7 @@ void Simulation::Impl::sum_totals() {
     totals.variable_nodes = s.variable;
     totals.failed_nodes = s.failed;
     totals.pairs = lists.entries();
+    totals.neighbour_searches = searches;
     totals.planes.clear();
     for (std::size_t k = 0; k < rigid_planes.size(); ++k) {
         totals.planes.push_back({ghosts.planes()[rigid_planes[k]].name, reaction[k], impulse[k]});
@@ -563,5 +722,6 @@ int Simulation::threads() const { return impl_->threads.threads(); }
 std::vector<PhaseTime> Simulation::phase_times() const { return impl_->graph->times(); }
 std::vector<std::string> Simulation::phases() const { return impl_->graph->names(); }
 double Simulation::node_steps() const { return impl_->node_steps; }
+const CompressedRows& Simulation::neighbour_lists() const { return impl_->lists; }
 
 }  // namespace gpa

@@ -40,8 +40,11 @@ FlowStress johnson_cook_flow(const JohnsonCookStrength& jc, double plastic_strai
     if (t_star >= 1.0) {
         return {0.0, 0.0};
     }
-    const double thermal = 1.0 - std::pow(t_star, jc.m);  // pow(0, m) = 0 for m > 0
-    const double rate = 1.0 + jc.c * std::log(std::max(strain_rate / jc.reference_strain_rate, 1.0));
+    // pow(0, m) = 0 for m > 0 and ln(1) = 0: both calls are skipped where they give those (at
+    // room temperature and without plastic flow, most points of most steps).
+    const double thermal = t_star > 0.0 ? 1.0 - std::pow(t_star, jc.m) : 1.0;
+    const double rate_ratio = strain_rate / jc.reference_strain_rate;
+    const double rate = rate_ratio > 1.0 ? 1.0 + jc.c * std::log(rate_ratio) : 1.0;
 
     double hardening = jc.a;
     double slope = 0.0;

@@ -38,7 +38,8 @@ struct PairFields {
         Vec<D> dx;
         for (int c = 0; c < D; ++c) dx[c] = position[c][j] - position[c][i];
         p.r = dx.norm();
-        p.l = dx / p.r;
+        p.inv_r = 1.0 / p.r;
+        p.l = dx * p.inv_r;
         p.h = pair_smoothing_length(influence_distance, diameter[i], diameter[j]);
         const bool lattice_pair = connectivity[i] == Connectivity::Fixed && body[i] == body[j];
         p.R = lattice_pair ? fixed_pair_weight : VariableWeight::value(p.r / p.h);

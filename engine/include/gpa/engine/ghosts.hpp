@@ -53,10 +53,32 @@ public:
     // fixed list names as a mirrored neighbour; across a lift-off plane only nodes in contact
     // have ghosts. Copies positions, velocities and the geometry fields (mass, volume, size
     // weight, diameter, connectivity, body, material, failed).
-    void build(NodeStore& nodes, std::size_t real_count, double range);
+    //
+    // keep_between_searches: the set is to serve several steps (neighbour lists with a skin):
+    // every node within `range` gets its ghosts whatever its contact state, so that contacts can
+    // change without a new set; the pairs of nodes out of contact are removed from the lists
+    // every step instead (remove_pairs_without_contact), which gives the same pairs.
+    void build(NodeStore& nodes, std::size_t real_count, double range, bool keep_between_searches = false);
+
+    // Re-copies, for the ghosts of the last build, the fields that build() copies, from the
+    // sources' current values (positions and velocities mirrored).
+    void update(NodeStore& nodes, std::size_t real_count) const;
+
+    // True when the ghosts of the last build include every real node within `range` of all
+    // planes of a corner combination (ignoring contact): the set still serves that range.
+    bool covers(const NodeStore& nodes, std::size_t real_count, double range) const;
+
+    // A bound on how much the distance of any real node to any ghost has changed since the
+    // positions `reference` (real nodes [0, real_count), taken at the last build): per corner
+    // combination, 2 max |u - U| over the nodes with such a ghost, u their displacement and U
+    // the middle of those displacements with its components normal to the planes set to zero
+    // (a mirror leaves U unchanged, so |u_i - mirror(u_s)| <= |u_i - U| + |u_s - U|).
+    double mirrored_displacement_bound(const NodeStore& nodes, std::size_t real_count,
+                                       const std::array<std::vector<double>, 3>& reference) const;
 
     // Removes from the real centres' rows [0, real_count) the ghosts of lift-off planes that the
-    // centre does not touch, so that only nodes in contact interact with those ghosts.
+    // centre or the ghost's source does not touch, so that only nodes in contact interact with
+    // those ghosts.
     void remove_pairs_without_contact(CompressedRows& lists, const NodeStore& nodes, std::size_t real_count) const;
 
     // Copies the fields of the stress phase and the gradient from the sources: alpha, stress
@@ -65,6 +87,7 @@ public:
 
     // For every real node, the ghost indices of its mirrored lattice neighbours
     // (NodeStore::fixed_mirrors resolved against the current ghosts).
+    // (After a build with keep_between_searches, all of them, in contact or not.)
     const CompressedRows& resolved_fixed_mirrors(const NodeStore& nodes, std::size_t real_count);
 
     // Appends the rows of the ghost centres to `lists` (which holds the rows of the real
@@ -87,12 +110,19 @@ private:
     std::vector<std::vector<std::int64_t>> index_;  // per mask slot, per real node: ghost node or -1
     std::vector<NodeIndex> source_;
     std::vector<std::uint8_t> mask_;
+    std::vector<std::uint8_t> slot_;          // per ghost: the index of its mask in masks_
+    std::vector<NodeIndex> sources_sorted_;   // the real nodes with ghosts, ascending, once each
     std::uint8_t lift_off_mask_ = 0;  // bits of the lift-off planes
+    bool keep_between_searches_ = false;
     CompressedRows resolved_;
     std::size_t mask_slot(std::uint8_t mask) const;
     // True when real node i may have (or be paired with) ghosts across the planes of `mask`.
     bool allowed(const NodeStore& nodes, std::size_t i, std::uint8_t mask) const {
         return (mask & lift_off_mask_ & ~nodes.plane_contact[i]) == 0;
+    }
+    // Whether node i may have ghosts across `mask` in this set (every node, in a kept set).
+    bool selectable(const NodeStore& nodes, std::size_t i, std::uint8_t mask) const {
+        return keep_between_searches_ || allowed(nodes, i, mask);
     }
 };
 

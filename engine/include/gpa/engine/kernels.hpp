@@ -23,6 +23,7 @@ template <int D>
 struct PairGeometry {
     Vec<D> l;      // unit vector from i to j
     double r;      // |x_j - x_i|
+    double inv_r;  // 1 / r (once per pair: the kernels multiply by it instead of dividing)
     double h;      // h_ij (Eq. 2)
     double R;      // distance weight R_ij (Eq. 1a, 1b, or 62-65)
 };
@@ -49,9 +50,10 @@ inline void accumulate_gradient(const PairGeometry<D>& p, double size_weight_j, 
     } else {
         sums.moment += rw * p.l.cwiseProduct(p.l);
     }
-    sums.difference.noalias() += (rw / p.r) * dv * p.l.transpose();
-    sums.smallest_h = std::fmin(sums.smallest_h, p.h);
-    const Vec<D> u = (rw / p.r) * p.l;
+    const double rw_over_r = rw * p.inv_r;
+    sums.difference.noalias() += rw_over_r * dv * p.l.transpose();
+    if (p.h < sums.smallest_h) sums.smallest_h = p.h;  // (a NaN h is skipped, as fmin would)
+    const Vec<D> u = rw_over_r * p.l;
     sums.stiffness.noalias() += u * u.transpose();
 }
 
@@ -90,7 +92,7 @@ inline double volumetric_strain_rate(const Mat<G::dim>& L, double radial_velocit
 template <int D>
 inline Vec<D> pair_force(const PairGeometry<D>& p, double volume_i, double size_weight_j,
                          const Vec<D>& normalised_l, const Mat<D>& sigma_i, double bond_q) {
-    return (-p.R * volume_i * size_weight_j / p.r) * (sigma_i * normalised_l - bond_q * normalised_l);
+    return (-p.R * volume_i * size_weight_j * p.inv_r) * (sigma_i * normalised_l - bond_q * normalised_l);
 }
 
 // Eq. 23 (with Eq. 32 read as "+ P_hoop", see spec section 5): the hoop stress of an

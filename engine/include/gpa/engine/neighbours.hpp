@@ -6,6 +6,7 @@
 
 #include <array>
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #include "gpa/engine/compressed_rows.hpp"
@@ -49,10 +50,20 @@ struct NeighbourScratch {
 //   images of lattice neighbours across planes), then every node of another body with
 //   r_ij < 2 h_ij.
 // Deterministic and independent of the thread count. Validates a (0.8-1.5).
+// With skin > 0 (a length) the searched part of each row holds candidates instead: every j with
+// r_ij < 2 h_ij + skin. filter_candidates() then cuts them to the pairs of the moment; they stay
+// a superset of the pairs until some pair has closed by more than the skin (Verlet lists).
 void find_neighbours(const NodeStore& nodes, double influence_distance, std::size_t centres,
                      CompressedRows& out, NeighbourScratch& scratch,
-                     const CompressedRows* extra_fixed = nullptr);
+                     const CompressedRows* extra_fixed = nullptr, double skin = 0.0);
 CompressedRows find_neighbours(const NodeStore& nodes, double influence_distance, std::size_t centres);
+
+// The pairs of the moment from candidate lists: of row i, the first unconditional[i] entries (a
+// fixed centre's lattice neighbours and their mirrors) and every other j with r_ij < 2 h_ij, in
+// the candidates' order. Deterministic and independent of the thread count.
+void filter_candidates(const NodeStore& nodes, double influence_distance, const CompressedRows& candidates,
+                       const std::vector<std::uint32_t>& unconditional, CompressedRows& out,
+                       std::vector<std::uint8_t>& keep);
 
 // The same lists from an all-pairs loop: the check for find_neighbours. O(n^2).
 CompressedRows find_neighbours_brute_force(const NodeStore& nodes, double influence_distance,

@@ -114,6 +114,15 @@ struct SolverOptions {
     bool failure = false;                // apply the materials' failure models (J-C damage, spall)
     ScatterScheme scatter = ScatterScheme::Slabs;
     std::size_t reorder_interval = 200;  // steps between locality reorderings (0 = never)
+    // Neighbour lists with a skin (Verlet lists): the search keeps every pair within
+    // 2 h_ij + skin, skin = neighbour_skin times the largest interaction radius, and is repeated
+    // only when nodes have moved (or grown) enough that a pair could have closed by the skin; in
+    // between, each step cuts the candidates to r_ij < 2 h_ij. 0 = a full search every step. The
+    // lists are the same either way; only the order of a row's entries may differ.
+    double neighbour_skin = 0.15;
+    // For tests: after every step's cut of the candidates, search all pairs afresh and throw
+    // NumericalError if the lists differ as sets (slow; not read from scene files).
+    bool check_neighbour_lists = false;
 };
 
 struct StopCriteria {

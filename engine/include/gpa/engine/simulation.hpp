@@ -5,6 +5,7 @@
 //   x^{n+1} = x^n + dt v^{n+1/2}                          move (and penetration guard)
 //   [every reorder_interval steps: nodes in cell order]  reorder
 //   geometry at x^{n+1}: d, W, ghosts, neighbours, alpha  geometry, neighbours, gradient
+//     (a full search only when the candidate lists with a skin may have gone stale)
 //   L from v^{n+1/2}; eps_v, V, sigma^{n+1}, e^{n+1}      stress
 //   ghost stresses, the scatter plan                      plan
 //   dt^{n+3/2} = C_cfl min l / (c + sqrt(Q / rho))        time step
@@ -21,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include "gpa/engine/compressed_rows.hpp"
 #include "gpa/engine/node_store.hpp"
 #include "gpa/engine/phase_graph.hpp"
 #include "gpa/engine/scene.hpp"
@@ -51,6 +53,7 @@ struct Totals {
     double length = 0.0;              // max over nodes of (distance from the first rigid plane + d/2), m
     double footprint_diameter = 0.0;  // width of the nodes within d of the first rigid plane, m
     std::size_t real_nodes = 0, ghost_nodes = 0, variable_nodes = 0, failed_nodes = 0, pairs = 0;
+    std::size_t neighbour_searches = 0;  // full searches so far (the others steps reuse candidate lists)
 };
 
 class Simulation {
@@ -79,6 +82,9 @@ public:
     std::vector<std::string> phases() const;
     // Real node-steps processed so far (sum over steps of the real node count).
     double node_steps() const;
+    // The neighbour lists of the last step: rows [0, real_count()) of the real nodes, then the
+    // rows of the ghosts (indices >= real_count() are ghosts).
+    const CompressedRows& neighbour_lists() const;
 
 private:
     struct Impl;
