@@ -262,6 +262,11 @@ void check_solver(const SolverOptions& s) {
         fail(fmt::format("solver.smoothing_coefficient = {} is outside [0, 1)", s.smoothing_coefficient));
     }
     if (!(s.cfl > 0.0 && s.cfl <= 1.0)) fail(fmt::format("solver.cfl = {} is outside (0, 1]", s.cfl));
+    if (!(s.neighbour_skin >= 0.0 && s.neighbour_skin <= 1.0)) {
+        fail(fmt::format("solver.neighbour_skin = {} is outside [0, 1] (a fraction of the largest interaction radius; "
+                         "0 = a full search every step)",
+                         s.neighbour_skin));
+    }
     if (!(s.alpha_limit >= 0.0 && finite(s.alpha_limit))) {
         fail(fmt::format("solver.alpha_limit = {} must be a finite number >= 0 (0 = no limit)", s.alpha_limit));
     }

@@ -36,7 +36,7 @@ const std::vector<std::string_view> solver_keys{
     "connectivity", "switch_plastic_strain", "influence_distance", "weight",          "viscosity",
     "normalisation", "viscosity_linear", "viscosity_quadratic", "bond_viscosity_eps0", "smoothing",     "smoothing_coefficient",
     "cfl",          "alpha_limit",           "max_time_step",      "time_step_growth", "failure",
-    "scatter",      "reorder_interval",
+    "scatter",      "reorder_interval",      "neighbour_skin",
 };
 const std::vector<std::string_view> stop_keys{"end_time", "kinetic_energy_fraction", "max_steps"};
 const std::vector<std::string_view> output_keys{"snapshots", "snapshot_interval", "history_every"};
@@ -316,6 +316,7 @@ SolverOptions read_solver(const Reporter& reporter, const toml::table& table) {
     if (const auto v = r.quantity("smoothing_coefficient", D::Dimensionless)) s.smoothing_coefficient = *v;
     if (const auto v = r.quantity("cfl", D::Dimensionless)) s.cfl = *v;
     if (const auto v = r.quantity("alpha_limit", D::Dimensionless)) s.alpha_limit = *v;
+    if (const auto v = r.quantity("neighbour_skin", D::Dimensionless)) s.neighbour_skin = *v;
     if (const auto v = r.quantity("max_time_step", D::Time, Limit::PositiveOrInfinite)) s.max_time_step = *v;
     if (const auto v = r.quantity("time_step_growth", D::Dimensionless)) s.time_step_growth = *v;
     if (const auto v = r.boolean("failure")) s.failure = *v;

@@ -102,6 +102,7 @@ TEST(SceneFormatDoc, DefaultsAreThoseOfSceneHpp) {
     expect_word(doc, "failure", s.failure ? "true" : "false");
     expect_word(doc, "scatter", word(s.scatter));
     expect_number(doc, "reorder_interval", static_cast<double>(s.reorder_interval));
+    expect_number(doc, "neighbour_skin", s.neighbour_skin);
 
     const StopCriteria stop;
     expect_number(doc, "end_time", stop.end_time);
@@ -113,9 +114,9 @@ TEST(SceneFormatDoc, DefaultsAreThoseOfSceneHpp) {
     expect_number(doc, "snapshot_interval", o.snapshot_interval);
     expect_number(doc, "history_every", static_cast<double>(o.history_every));
 
-    // 18 solver options, 3 stop criteria, 3 output options, and no row for an option that does
+    // 19 solver options, 3 stop criteria, 3 output options, and no row for an option that does
     // not exist.
-    EXPECT_EQ(doc.size(), 24u) << "rows in [solver], [stop] and [output] of docs/scene-format.md";
+    EXPECT_EQ(doc.size(), 25u) << "rows in [solver], [stop] and [output] of docs/scene-format.md";
 }
 
 }  // namespace
