@@ -242,20 +242,30 @@ void Simulation::Impl::move() {
     // Penetration guard: a node that ends behind a plane is put back just in front of it and
     // loses its velocity towards it; the kinetic energy and momentum it loses are booked as
     // boundary work and plane impulse (spec section 7).
+    // (In parallel, with sums of a fixed order, so that they do not depend on the thread count.)
     for (std::size_t p = 0; p < ghosts.planes().size(); ++p) {
         const auto& plane = ghosts.planes()[p];
         const auto rigid = std::find(rigid_planes.begin(), rigid_planes.end(), p);
-        for (std::size_t i = 0; i < real; ++i) {
-            double& x = nodes.position[plane.axis][i];
-            if (plane.distance(x) > 0.0) continue;
-            x = plane.position + plane.side * 0.01 * nodes.initial_diameter[i];
-            double& v = nodes.velocity[plane.axis][i];
-            if (plane.side * v < 0.0) {
-                boundary_work += 0.5 * nodes.mass[i] * v * v;
-                if (rigid != rigid_planes.end()) impulse[rigid - rigid_planes.begin()] -= plane.side * nodes.mass[i] * v;
-                v = 0.0;
-            }
-        }
+        using WorkAndImpulse = std::array<double, 2>;
+        const WorkAndImpulse lost = tbb::parallel_deterministic_reduce(
+            tbb::blocked_range<std::size_t>(0, real, reduce_grain), WorkAndImpulse{0.0, 0.0},
+            [&](const tbb::blocked_range<std::size_t>& r, WorkAndImpulse acc) {
+                for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                    double& x = nodes.position[plane.axis][i];
+                    if (plane.distance(x) > 0.0) continue;
+                    x = plane.position + plane.side * 0.01 * nodes.initial_diameter[i];
+                    double& v = nodes.velocity[plane.axis][i];
+                    if (plane.side * v < 0.0) {
+                        acc[0] += 0.5 * nodes.mass[i] * v * v;
+                        acc[1] -= plane.side * nodes.mass[i] * v;
+                        v = 0.0;
+                    }
+                }
+                return acc;
+            },
+            [](WorkAndImpulse x, const WorkAndImpulse& y) { return WorkAndImpulse{x[0] + y[0], x[1] + y[1]}; });
+        boundary_work += lost[0];
+        if (rigid != rigid_planes.end()) impulse[rigid - rigid_planes.begin()] += lost[1];
     }
 }
 
