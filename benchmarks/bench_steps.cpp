@@ -114,6 +114,15 @@ bool reset_peak_memory() {
     return static_cast<bool>(f);
 }
 
+double resident_memory_bytes() {
+    std::ifstream f("/proc/self/status");
+    std::string line;
+    while (std::getline(f, line)) {
+        if (line.rfind("VmRSS:", 0) == 0) return std::stod(line.substr(6)) * 1024.0;
+    }
+    return 0.0;
+}
+
 double peak_memory_bytes() {
     std::ifstream f("/proc/self/status");
     std::string line;
@@ -273,7 +282,12 @@ int main(int argc, char** argv) {
                 double real = 0.0, searches = 0.0;
                 {
                     gpa::Simulation sim(scene, static_cast<int>(thread_list.back()));
+                    const double after_setup = peak_memory_bytes();
                     for (int k = 0; k < 25; ++k) sim.step();  // two reorders, and searches
+                    fmt::print("memory {}: peak {:.0f} B/node after set-up, {:.0f} after 25 steps, resident now {:.0f}\n", name,
+                               after_setup / static_cast<double>(sim.real_count()),
+                               peak_memory_bytes() / static_cast<double>(sim.real_count()),
+                               resident_memory_bytes() / static_cast<double>(sim.real_count()));
                     const fs::path dir = fs::temp_directory_path() / fmt::format("gpa_bench_steps_{}", ::getpid());
                     fs::create_directories(dir);
                     gpa::io::SnapshotSeries series(dir);

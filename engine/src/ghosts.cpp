@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <limits>
 
 #include <fmt/format.h>
 #include <tbb/blocked_range.h>
@@ -142,11 +143,14 @@ void GhostSet::build(NodeStore& nodes, std::size_t real_count, double range, boo
             needed[slot][i] = 1;
         }
     }
+    if (real_count * (masks_.size() + 1) > static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max())) {
+        throw InputError(fmt::format("{} nodes: too many for the ghost index (32-bit)", real_count));
+    }
     for (std::size_t slot = 0; slot < masks_.size(); ++slot) {
         index_[slot].assign(real_count, -1);
         for (std::size_t i = 0; i < real_count; ++i) {
             if (!needed[slot][i]) continue;
-            index_[slot][i] = static_cast<std::int64_t>(real_count + source_.size());
+            index_[slot][i] = static_cast<std::int32_t>(real_count + source_.size());
             source_.push_back(static_cast<NodeIndex>(i));
             mask_.push_back(masks_[slot]);
             slot_.push_back(static_cast<std::uint8_t>(slot));
@@ -334,12 +338,12 @@ void GhostSet::append_ghost_rows(CompressedRows& lists, std::size_t real_count) 
         }
     }
     const std::size_t base = lists.entries();
-    lists.offsets.resize(real_count + ghosts + 1);
+    resize_with_slack(lists.offsets, real_count + ghosts + 1);
     for (std::size_t k = 0; k < ghosts; ++k) {
         count[k + 1] += count[k];
         lists.offsets[real_count + k + 1] = base + count[k + 1];
     }
-    lists.indices.resize(base + count[ghosts]);
+    resize_with_slack(lists.indices, base + count[ghosts]);
     std::vector<std::size_t> next(ghosts);
     for (std::size_t k = 0; k < ghosts; ++k) next[k] = base + count[k];
     for (const NodeIndex s : sources_sorted_) {

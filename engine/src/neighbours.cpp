@@ -124,72 +124,64 @@ void find_neighbours(const NodeStore& nodes, double a, std::size_t centres, Comp
     const CellGrid& grid = scratch.grid;
     const int dim = nodes.dim();
 
-    const std::size_t blocks = (centres + search_block - 1) / search_block;
-    scratch.block_indices.resize(blocks);
-    scratch.block_counts.resize(blocks);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, blocks, 1), [&](const tbb::blocked_range<std::size_t>& r) {
-        for (std::size_t b = r.begin(); b != r.end(); ++b) {
-            auto& indices = scratch.block_indices[b];
-            auto& counts = scratch.block_counts[b];
-            indices.clear();
-            counts.clear();
-            const std::size_t first = b * search_block, last = std::min(centres, first + search_block);
-            for (std::size_t i = first; i < last; ++i) {
-                const std::size_t before = indices.size();
-                const bool fixed = nodes.connectivity[i] == Connectivity::Fixed;
-                if (fixed) {
-                    const auto row = nodes.fixed_neighbours.row(i);
-                    indices.insert(indices.end(), row.begin(), row.end());
-                    if (extra_fixed) {
-                        const auto extra = extra_fixed->row(i);
-                        indices.insert(indices.end(), extra.begin(), extra.end());
-                    }
-                }
-                if (search) {
-                    const auto home = grid.cell_of(nodes, i);
-                    std::array<std::size_t, 3> lo{0, 0, 0}, hi{0, 0, 0};
-                    for (int k = 0; k < dim; ++k) {
-                        lo[k] = home[k] == 0 ? 0 : home[k] - 1;
-                        hi[k] = std::min(grid.cells[k] - 1, home[k] + 1);
-                    }
-                    const std::int32_t own_body = nodes.body[i];
-                    std::array<std::size_t, 3> c{0, 0, 0};
-                    for (c[2] = lo[2]; c[2] <= hi[2]; ++c[2]) {
-                        for (c[1] = lo[1]; c[1] <= hi[1]; ++c[1]) {
-                            for (c[0] = lo[0]; c[0] <= hi[0]; ++c[0]) {
-                                const std::size_t cell = grid.linear(c);
-                                for (std::size_t k = grid.cell_start[cell]; k < grid.cell_start[cell + 1]; ++k) {
-                                    const NodeIndex j = grid.nodes[k];
-                                    if (j == i || (fixed && nodes.body[j] == own_body)) continue;
-                                    if (skin > 0.0 ? is_candidate(nodes, a, skin, i, j) : is_pair(nodes, a, i, j)) {
-                                        indices.push_back(j);
-                                    }
-                                }
-                            }
-                        }
-                    }
-                }
-                counts.push_back(indices.size() - before);
+    // Calls emit(j) for every neighbour j of centre i, in the order described in the header.
+    const auto visit = [&](std::size_t i, auto&& emit) {
+        const bool fixed = nodes.connectivity[i] == Connectivity::Fixed;
+        if (fixed) {
+            for (NodeIndex j : nodes.fixed_neighbours.row(i)) emit(j);
+            if (extra_fixed) {
+                for (NodeIndex j : extra_fixed->row(i)) emit(j);
             }
         }
-    });
+        if (!search) return;
+        const auto home = grid.cell_of(nodes, i);
+        std::array<std::size_t, 3> lo{0, 0, 0}, hi{0, 0, 0};
+        for (int k = 0; k < dim; ++k) {
+            lo[k] = home[k] == 0 ? 0 : home[k] - 1;
+            hi[k] = std::min(grid.cells[k] - 1, home[k] + 1);
+        }
+        const std::int32_t own_body = nodes.body[i];
+        std::array<std::size_t, 3> c{0, 0, 0};
+        for (c[2] = lo[2]; c[2] <= hi[2]; ++c[2]) {
+            for (c[1] = lo[1]; c[1] <= hi[1]; ++c[1]) {
+                for (c[0] = lo[0]; c[0] <= hi[0]; ++c[0]) {
+                    const std::size_t cell = grid.linear(c);
+                    for (std::size_t k = grid.cell_start[cell]; k < grid.cell_start[cell + 1]; ++k) {
+                        const NodeIndex j = grid.nodes[k];
+                        if (j == i || (fixed && nodes.body[j] == own_body)) continue;
+                        if (skin > 0.0 ? is_candidate(nodes, a, skin, i, j) : is_pair(nodes, a, i, j)) emit(j);
+                    }
+                }
+            }
+        }
+    };
 
-    out.offsets.resize(centres + 1);
+    // Two passes, count and fill, straight into the output: no per-block buffers, so the peak
+    // memory of a search is the lists themselves (the search runs once in many steps with a skin).
+    resize_with_slack(out.offsets, centres + 1);
     out.offsets[0] = 0;
-    std::size_t i = 0;
-    for (std::size_t b = 0; b < blocks; ++b) {
-        for (std::size_t count : scratch.block_counts[b]) {
-            out.offsets[i + 1] = out.offsets[i] + count;
-            ++i;
-        }
-    }
-    out.indices.resize(out.offsets[centres]);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, blocks, 1), [&](const tbb::blocked_range<std::size_t>& r) {
-        for (std::size_t b = r.begin(); b != r.end(); ++b) {
-            const auto& src = scratch.block_indices[b];
-            std::copy(src.begin(), src.end(), out.indices.begin() + out.offsets[b * search_block]);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, centres, search_block), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+            std::size_t count = 0;
+            visit(i, [&](NodeIndex) { ++count; });
+            out.offsets[i + 1] = count;
         }
     });
+    for (std::size_t i = 0; i < centres; ++i) out.offsets[i + 1] += out.offsets[i];
+    resize_with_slack(out.indices, out.offsets[centres]);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, centres, search_block), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+            std::size_t next = out.offsets[i];
+            visit(i, [&](NodeIndex j) { out.indices[next++] = j; });
+        }
+    });
+}
+
+CompressedRows find_neighbours(const NodeStore& nodes, double a, std::size_t centres) {
+    CompressedRows out;
+    NeighbourScratch scratch;
+    find_neighbours(nodes, a, centres, out, scratch);
+    return out;
 }
 
 namespace {
@@ -228,7 +220,7 @@ void filter_rows(const NodeStore& nodes, double a, const CompressedRows& candida
         }
     });
     for (std::size_t i = 0; i < rows; ++i) out.offsets[i + 1] += out.offsets[i];
-    out.indices.resize(out.offsets[rows]);
+    resize_with_slack(out.indices, out.offsets[rows]);
     // Pass 2: copy the kept entries in order.
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rows, search_block), [&](const tbb::blocked_range<std::size_t>& r) {
         for (std::size_t i = r.begin(); i != r.end(); ++i) {
@@ -250,7 +242,7 @@ void filter_candidates(const NodeStore& nodes, double a, const CompressedRows& c
         throw InputError(fmt::format("filter_candidates: {} unconditional counts for {} rows", unconditional.size(), rows));
     }
     keep.resize(candidates.entries());
-    out.offsets.resize(rows + 1);
+    resize_with_slack(out.offsets, rows + 1);
     out.offsets[0] = 0;
     if (nodes.dim() == 2) {
         filter_rows<2>(nodes, a, candidates, unconditional, out, keep);
@@ -259,12 +251,6 @@ void filter_candidates(const NodeStore& nodes, double a, const CompressedRows& c
     }
 }
 
-CompressedRows find_neighbours(const NodeStore& nodes, double a, std::size_t centres) {
-    CompressedRows out;
-    NeighbourScratch scratch;
-    find_neighbours(nodes, a, centres, out, scratch);
-    return out;
-}
 
 CompressedRows find_neighbours_brute_force(const NodeStore& nodes, double a, std::size_t centres,
                                            const CompressedRows* extra_fixed) {

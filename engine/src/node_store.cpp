@@ -112,7 +112,10 @@ void NodeStore::resize(std::size_t count) {
     if (count > std::size_t{0xFFFFFFFFu}) {
         throw InputError(fmt::format("node count {} exceeds the limit of 2^32 - 1 nodes", count));
     }
-    for_each_field([count](auto& field) { field.resize(count); });
+    // Growing past the capacity reserves 1/8 more than asked, not the doubling that resize()
+    // itself would do: the ghosts come and go every step, and doubled fields would double the
+    // memory of a run.
+    for_each_field([count](auto& field) { resize_with_slack(field, count); });
     resize_rows(fixed_neighbours, nullptr, count);
     resize_rows(fixed_mirrors, &fixed_mirror_planes, count);
 }

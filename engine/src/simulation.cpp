@@ -160,6 +160,25 @@ void Simulation::Impl::setup() {
     }
     real = nodes.size();
     validate_nodes(nodes, 0, real);
+    // Nodes of variable-connectivity bodies never read their lattice lists: drop them (memory).
+    const auto drop_variable_rows = [&](CompressedRows& rows, std::vector<std::uint8_t>* tags) {
+        CompressedRows kept;
+        std::vector<std::uint8_t> kept_tags;
+        kept.offsets.assign(1, 0);
+        for (std::size_t i = 0; i < real; ++i) {
+            if (body_mode[static_cast<std::size_t>(nodes.body[i])] != ConnectivityMode::Variable) {
+                for (std::size_t e = rows.offsets[i]; e < rows.offsets[i + 1]; ++e) {
+                    kept.indices.push_back(rows.indices[e]);
+                    if (tags) kept_tags.push_back((*tags)[e]);
+                }
+            }
+            kept.offsets.push_back(kept.indices.size());
+        }
+        rows = std::move(kept);
+        if (tags) *tags = std::move(kept_tags);
+    };
+    drop_variable_rows(nodes.fixed_neighbours, nullptr);
+    drop_variable_rows(nodes.fixed_mirrors, &nodes.fixed_mirror_planes);
     // A fixed-connectivity node meets a plane only through the mirror images of its lattice
     // neighbours, which exist when the body starts on the plane; a fixed or automatic body that
     // starts apart from a plane would pass through it.

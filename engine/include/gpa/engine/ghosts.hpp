@@ -107,7 +107,7 @@ public:
 private:
     std::vector<GhostPlane> planes_;
     std::vector<std::uint8_t> masks_;            // the corner combinations in use: distinct axes
-    std::vector<std::vector<std::int64_t>> index_;  // per mask slot, per real node: ghost node or -1
+    std::vector<std::vector<std::int32_t>> index_;  // per mask slot, per real node: ghost node or -1
     std::vector<NodeIndex> source_;
     std::vector<std::uint8_t> mask_;
     std::vector<std::uint8_t> slot_;          // per ghost: the index of its mask in masks_

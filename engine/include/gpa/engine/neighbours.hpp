@@ -37,11 +37,9 @@ struct CellGrid {
 // than one body.
 bool needs_search(const NodeStore& nodes, std::size_t centres);
 
-// Reusable state of the search (the grid and per-block buffers), kept between steps.
+// Reusable state of the search (the cell grid), kept between searches.
 struct NeighbourScratch {
     CellGrid grid;
-    std::vector<std::vector<NodeIndex>> block_indices;
-    std::vector<std::vector<std::size_t>> block_counts;
 };
 
 // The neighbour lists of centres [0, centres), drawn from all nodes [0, nodes.size()):
