@@ -1,5 +1,6 @@
 // gpa: high-velocity impact simulation with the Generalized Particle Algorithm.
 //   gpa run [SCENE] [-o DIR] [--threads N] [--overwrite] [--quiet]
+//   gpa study SCENE [-o DIR] [--refine 1,1.5,2] [--variant NAME:key=value,...]... [--threads 1,2] [--overwrite] [-q]
 //   gpa check SCENE
 //   gpa materials
 //   gpa demo [--threads N] [-o DIR]
@@ -13,7 +14,9 @@
 #include "demo.hpp"
 #include "gpa/engine/errors.hpp"
 #include "gpa/io/output.hpp"
+#include "gpa/io/study.hpp"
 #include "run.hpp"
+#include "study.hpp"
 
 int main(int argc, char** argv) {
     CLI::App app{"gpa: high-velocity impact simulation with the Generalized Particle Algorithm "
@@ -28,6 +31,23 @@ int main(int argc, char** argv) {
     run->add_option("--threads", run_options.threads, "threads (0 = all hardware threads)")->check(CLI::Range(0, 4096));
     run->add_flag("--overwrite", run_options.overwrite, "replace an existing output folder when the run ends");
     run->add_flag("-q,--quiet", run_options.quiet, "no progress and no report, only where the output went");
+
+    gpa::app::StudyOptions study_options;
+    std::string study_scene, study_output;
+    auto* study = app.add_subcommand("study", "run a scene over resolutions and method variants: wall time, memory, "
+                                              "metrics, discretisation and reference errors (docs/study.md)");
+    study->add_option("scene", study_scene, "scene file (TOML)")->required();
+    study->add_option("-o,--output", study_output, "output folder (default: studies/<scene>-<date>-<time>)");
+    study->add_option("--refine", study_options.refine,
+                      "refinement factors: every body's spacing is divided by each (default 1,1.5,2)");
+    study->add_option("--variant", study_options.variants,
+                      "a method variant, NAME or NAME:key=value,...; repeat for more (default: the scene as written). Keys: " +
+                          gpa::io::variant_keys_help())
+        ->expected(1)
+        ->take_all();
+    study->add_option("--threads", study_options.threads, "thread counts, e.g. 1,2 (0 = all hardware threads; default 0)");
+    study->add_flag("--overwrite", study_options.overwrite, "replace an existing output folder when the study ends");
+    study->add_flag("-q,--quiet", study_options.quiet, "no progress and no summary, only where the output went");
 
     std::string check_file;
     auto* check = app.add_subcommand("check", "read and check a scene without running it");
@@ -51,6 +71,11 @@ int main(int argc, char** argv) {
             if (!scene.empty()) run_options.scene = scene;
             if (!output.empty()) run_options.output = output;
             return gpa::app::run_scene(run_options);
+        }
+        if (study->parsed()) {
+            study_options.scene = study_scene;
+            if (!study_output.empty()) study_options.output = study_output;
+            return gpa::app::run_study(study_options);
         }
         if (check->parsed()) return gpa::app::check_scene(check_file);
         if (materials->parsed()) return gpa::app::list_materials();

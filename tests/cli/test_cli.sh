@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The gpa command on bad input: every malformed scene and bad command line ends with a one-line
 # message and a non-zero exit (never a crash), and an existing output folder is never touched.
+# Also `gpa study` on a small bar (tests/cli/study-bar.toml): its outputs, and its bad options.
 # Usage: test_cli.sh GPA_BINARY SOURCE_DIR WORK_DIR
 set -u
 gpa=$1; src=$2; work=$3
@@ -66,6 +67,61 @@ expect 0 "overwrite" -- "$gpa" run "$src/tests/cli/tiny.toml" -o keep --overwrit
 expect 0 "materials" -- "$gpa" materials
 for m in "OFHC copper" "Armco iron" "4340 steel" "2024-T351"; do grep -q "$m" out.txt || fail "materials lacks $m"; done
 expect 0 "check good scene" -- "$gpa" check "$src/scenes/taylor-copper-190.toml"
+
+# 6. gpa study: a small elastic bar over three resolutions, two variants and two thread counts.
+bar="$src/tests/cli/study-bar.toml"
+expect 0 "study" -- "$gpa" study "$bar" -o study --refine 1,1.5,2 --threads 1,2 --variant scene --variant sph:weight=sph -q
+for f in study.csv study.md error_vs_time.svg discretisation_error_vs_time.svg; do
+  [[ -s "study/$f" ]] || fail "study output lacks $f"
+done
+[[ -e study.partial ]] && fail "finished study left study.partial"
+rows=$(( $(wc -l < study/study.csv) - 1 ))
+[[ $rows -eq 12 ]] || fail "study.csv has $rows rows, expected 12 (3 resolutions x 2 variants x 2 thread counts)"
+for series in scene-1t scene-2t sph-1t sph-2t; do
+  n=$(cut -d, -f2 study/study.csv | grep -cx "$series")
+  [[ $n -eq 3 ]] || fail "study.csv has $n rows of series $series, expected 3"
+done
+head -1 study/study.csv | grep -q "contact_time_s,contact_time_discretisation_error,contact_time_reference_error" \
+  || fail "study.csv header lacks the contact-time columns: $(head -1 study/study.csv)"
+[[ $(grep -c ",finished," study/study.csv) -eq 12 ]] || fail "not every study case finished"
+grep -q "Observed orders" study/study.md || fail "study.md has no table of observed orders"
+grep -q "<polyline" study/error_vs_time.svg || fail "error_vs_time.svg draws no line"
+tail -1 study/error_vs_time.svg | grep -q "</svg>" || fail "error_vs_time.svg is not complete"
+grep -q "^output: study " out.txt || fail "study does not say where its output went: $(cat out.txt)"
+
+# Without --variant the scene as written is the one series; two resolutions give no order.
+expect 0 "study, two resolutions" -- "$gpa" study "$bar" -o study2 --refine 1,2 --threads 1 -q
+[[ $(( $(wc -l < study2/study.csv) - 1 )) -eq 2 ]] || fail "two-resolution study.csv rows"
+grep -q "fewer than three resolutions" study2/study.md || fail "two-resolution study.md does not say why there is no order"
+
+# Bad options: one line naming the option, exit 2, and no output folder.
+study_refused() {
+  local what=$1 fragment=$2; shift 2
+  expect 2 "study $what" -- "$gpa" study "$bar" -o refused -q "$@"
+  grep -qF -- "$fragment" err.txt || fail "study $what: message lacks '$fragment': $(cat err.txt)"
+  [[ -e refused || -e refused.partial ]] && fail "study $what left an output folder"
+}
+study_refused "refine not a number" "--refine '1,x'" --refine 1,x
+study_refused "refine twice" "listed twice" --refine 1,2,1
+study_refused "refine zero" "positive refinement factor" --refine 0,1
+study_refused "threads" "--threads" --threads 1,-1
+study_refused "unknown variant key" "unknown key 'colour'" --variant x:colour=red
+study_refused "bad variant value" "weight must be one of gpa, sph, sph-nsf" --variant x:weight=foo
+study_refused "variant without a name" "name before its settings" --variant weight=sph
+study_refused "variant name twice" "given twice" --variant a --variant a:weight=sph
+study_refused "variant out of range" "--variant fast" --variant fast:cfl=2
+study_refused "refinements on one lattice" "give the same lattice" --refine 1,1.01,2
+expect 2 "study of a missing scene" -- "$gpa" study "$work/no-such-scene.toml" -o refused -q
+[[ -e refused || -e refused.partial ]] && fail "study of a missing scene left an output folder"
+
+# An existing study folder is refused and left as it was; --overwrite replaces it at the end.
+mkdir -p keep2 && echo "precious" > keep2/result.txt
+expect 2 "study into an existing folder" -- "$gpa" study "$bar" -o keep2 -q --refine 1
+grep -q "overwrite" err.txt || fail "study refusal does not mention --overwrite: $(cat err.txt)"
+[[ "$(cat keep2/result.txt)" == "precious" ]] || fail "study changed an existing folder"
+expect 0 "study --overwrite" -- "$gpa" study "$bar" -o keep2 -q --refine 1 --overwrite
+[[ -e keep2/result.txt ]] && fail "study --overwrite kept the old contents"
+[[ -s keep2/study.csv ]] || fail "study --overwrite wrote no study.csv"
 
 echo "$failures failure(s)"
 exit $(( failures > 0 ))

@@ -1,0 +1,26 @@
+#pragma once
+// The `gpa study` command: one scene over several resolutions and method variants, with wall
+// time, throughput, peak memory, the scene's metrics and their errors (docs/study.md).
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace gpa::app {
+
+struct StudyOptions {
+    std::filesystem::path scene;
+    std::optional<std::filesystem::path> output;  // none: studies/<scene name>-<date-time>
+    std::string refine = "1,1.5,2";               // refinement factors, as typed
+    std::vector<std::string> variants;            // NAME[:key=value,...] as typed; none: the scene as written
+    std::string threads = "0";                    // thread counts, as typed
+    bool overwrite = false;
+    bool quiet = false;
+};
+
+// Runs the study; returns the process exit code (0, or 3 when a case failed; the outputs are
+// written either way). Bad options throw gpa::InputError before anything runs.
+int run_study(const StudyOptions& options);
+
+}  // namespace gpa::app
