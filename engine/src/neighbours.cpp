@@ -301,7 +301,8 @@ std::vector<NodeIndex> locality_order(const NodeStore& nodes, double cell_size, 
         }
         keyed[i - first] = {key, static_cast<NodeIndex>(i)};
     }
-    std::stable_sort(keyed.begin(), keyed.end(), [](const auto& p, const auto& q) { return p.first < q.first; });
+    // Ties broken by node index: the order of a stable sort, without its buffer.
+    std::sort(keyed.begin(), keyed.end());
     for (std::size_t k = 0; k < keyed.size(); ++k) order[first + k] = keyed[k].second;
     return order;
 }

@@ -422,9 +422,12 @@ void Simulation::Impl::search_candidates() {
     if (ghosts.empty()) {
         plan = make_plan(scene.solver.scatter, candidates, positions_of(nodes), nodes.size());
     } else {
-        CompressedRows with_ghosts = candidates;
-        ghosts.append_ghost_rows(with_ghosts, real);
-        plan = make_plan(scene.solver.scatter, with_ghosts, positions_of(nodes), nodes.size());
+        // The ghost rows go on the candidates for the plan and come off again (no copy: memory).
+        const std::size_t entries = candidates.entries();
+        ghosts.append_ghost_rows(candidates, real);
+        plan = make_plan(scene.solver.scatter, candidates, positions_of(nodes), nodes.size());
+        candidates.offsets.resize(real + 1);
+        candidates.indices.resize(entries);
     }
     search_due = false;
     ++searches;

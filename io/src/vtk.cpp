@@ -113,6 +113,7 @@ void write_vtp(const std::filesystem::path& path, const NodeStore& nodes, std::s
                     const double v = value(i, c);
                     put(&v, 8);
                 }
+                if (buffer.size() >= (std::size_t{1} << 20)) flush();  // a bounded buffer: no copy of a whole field
             }
             flush();
         };
@@ -124,6 +125,7 @@ void write_vtp(const std::filesystem::path& path, const NodeStore& nodes, std::s
             for (std::size_t i = 0; i < count; ++i) {
                 const std::int64_t v = static_cast<std::int64_t>(pass == 0 ? i : i + 1);
                 put(&v, 8);
+                if (buffer.size() >= (std::size_t{1} << 20)) flush();
             }
             flush();
         }
