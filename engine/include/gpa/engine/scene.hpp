@@ -119,7 +119,7 @@ struct SolverOptions {
     // only when nodes have moved (or grown) enough that a pair could have closed by the skin; in
     // between, each step cuts the candidates to r_ij < 2 h_ij. 0 = a full search every step. The
     // lists are the same either way; only the order of a row's entries may differ.
-    double neighbour_skin = 0.15;
+    double neighbour_skin = 0.25;
     // For tests: after every step's cut of the candidates, search all pairs afresh and throw
     // NumericalError if the lists differ as sets (slow; not read from scene files).
     bool check_neighbour_lists = false;
