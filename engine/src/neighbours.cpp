@@ -120,9 +120,15 @@ void find_neighbours(const NodeStore& nodes, double a, std::size_t centres, Comp
         throw InputError(fmt::format("find_neighbours: extra fixed lists cover {} of {} centres", extra_fixed->rows(), centres));
     }
     const bool search = needs_search(nodes, centres);
-    if (search) scratch.grid.build(nodes, n, largest_interaction_radius(nodes, a, n) + skin);
+    // Cells of half the reach, and the 5 (or 5 x 5 x 5) cells around a centre's: the cells cover
+    // 2.5 reaches across instead of 3, which spares about a third of the distance checks in 2D
+    // and half in 3D. (The grid may enlarge its cells to bound their number; the span follows.)
+    const double reach = largest_interaction_radius(nodes, a, n) + skin;
+    if (search) scratch.grid.build(nodes, n, 0.5 * reach);
     const CellGrid& grid = scratch.grid;
     const int dim = nodes.dim();
+    // A neighbour is less than `reach` away along each axis, so at most ceil(reach / edge) cells.
+    const std::size_t span = search && grid.cell_size > 0.0 ? static_cast<std::size_t>(std::ceil(reach / grid.cell_size)) : 1;
 
     // Calls emit(j) for every neighbour j of centre i, in the order described in the header.
     const auto visit = [&](std::size_t i, auto&& emit) {
@@ -137,8 +143,8 @@ void find_neighbours(const NodeStore& nodes, double a, std::size_t centres, Comp
         const auto home = grid.cell_of(nodes, i);
         std::array<std::size_t, 3> lo{0, 0, 0}, hi{0, 0, 0};
         for (int k = 0; k < dim; ++k) {
-            lo[k] = home[k] == 0 ? 0 : home[k] - 1;
-            hi[k] = std::min(grid.cells[k] - 1, home[k] + 1);
+            lo[k] = home[k] < span ? 0 : home[k] - span;
+            hi[k] = std::min(grid.cells[k] - 1, home[k] + span);
         }
         const std::int32_t own_body = nodes.body[i];
         std::array<std::size_t, 3> c{0, 0, 0};
