@@ -181,7 +181,7 @@ int check_scene(const fs::path& file) {
         fmt::print("  body \"{}\": {}, {} nodes, lattice spacing {:.4g} x {:.4g} mm\n", scene.bodies[b].name,
                    scene.bodies[b].material, count, block.spacing[0] * 1e3, block.spacing[1] * 1e3);
     }
-    fmt::print("  first time step {:.3g} ns; phases: {}\n", sim.totals().time_step * 1e9, fmt::join(sim.phases(), ", "));
+    fmt::print("  first time step {:.3g} ns; phases: {}\n", sim.next_time_step() * 1e9, fmt::join(sim.phases(), ", "));
     return 0;
 }
 

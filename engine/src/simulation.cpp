@@ -750,6 +750,7 @@ std::size_t Simulation::real_count() const { return impl_->real; }
 const Totals& Simulation::totals() const { return impl_->totals; }
 double Simulation::time() const { return impl_->time; }
 std::size_t Simulation::steps() const { return impl_->steps; }
+double Simulation::next_time_step() const { return impl_->dt_half; }
 int Simulation::threads() const { return impl_->threads.threads(); }
 std::vector<PhaseTime> Simulation::phase_times() const { return impl_->graph->times(); }
 std::vector<std::string> Simulation::phases() const { return impl_->graph->names(); }

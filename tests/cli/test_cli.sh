@@ -67,6 +67,9 @@ expect 0 "overwrite" -- "$gpa" run "$src/tests/cli/tiny.toml" -o keep --overwrit
 expect 0 "materials" -- "$gpa" materials
 for m in "OFHC copper" "Armco iron" "4340 steel" "2024-T351"; do grep -q "$m" out.txt || fail "materials lacks $m"; done
 expect 0 "check good scene" -- "$gpa" check "$src/scenes/taylor-copper-190.toml"
+# The first time step of the 0.254 mm copper bar is tens of nanoseconds (c about 4 km/s): a
+# "0 ns" there would mean the check printed a step not yet computed.
+grep -qE 'first time step [1-9][0-9.]* ns' out.txt || fail "check prints no positive first time step: $(grep 'time step' out.txt)"
 
 # 6. gpa study: a small elastic bar over three resolutions, two variants and two thread counts.
 bar="$src/tests/cli/study-bar.toml"

@@ -76,6 +76,8 @@ public:
     const Totals& totals() const;
     double time() const;
     std::size_t steps() const;
+    // The time step the next step() advances by (dt^{n+1/2}; totals().time_step is the last one taken).
+    double next_time_step() const;
     int threads() const;
     std::vector<PhaseTime> phase_times() const;
     // The names of the phases in this scene's graph, in order.
