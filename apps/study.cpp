@@ -148,11 +148,12 @@ void print_summary(const io::StudyReport& report, const io::StudyAnalysis& analy
         for (const auto& series : analysis.series) {
             const auto& x = analysis.extrapolations.at({series, key});
             if (x.status == io::ConvergenceStatus::Converging) {
-                fmt::print("    {}: extrapolated {:.5g} {}, observed order {}{}\n", series, x.extrapolated * m->display_scale,
+                fmt::print("    {}: extrapolated {:.5g} {}, observed order {}{}{}\n", series, x.extrapolated * m->display_scale,
                            m->display_unit, std::isfinite(x.order) ? fmt::format("{:.2f}", x.order) : "> 64",
                            ref != report.reference.end()
                                ? fmt::format(", {:+.2f} % from the answer", 100.0 * io::relative_error(x.extrapolated, ref->second))
-                               : "");
+                               : "",
+                           x.slow ? " (converging slowly: a rough guess)" : "");
             } else {
                 fmt::print("    {}: {}\n", series, io::describe(x.status));
             }

@@ -260,6 +260,8 @@ Extrapolation extrapolate(std::span<const double> spacing, std::span<const doubl
     } else {
         e.status = ConvergenceStatus::Converging;
         e.extrapolated = richardson_limit(h2, h3, f2, f3, e.order);
+        e.slow = e.order < slow_order;
+        e.gain = std::isinf(e.order) ? 0.0 : 1.0 / std::expm1(e.order * std::log(h2 / h3));
     }
     return e;
 }
@@ -653,6 +655,11 @@ void write_study_markdown(const fs::path& file, const StudyReport& report, const
             std::string note(describe(x.status));
             if (x.status == ConvergenceStatus::NotMonotone) note += ": no order, no extrapolation";
             if (x.status == ConvergenceStatus::Diverging) note += ": the differences grow; no extrapolation";
+            if (x.slow) {
+                note = fmt::format("converging slowly (order below {:g}): the extrapolation adds {:.3g} times the last "
+                                   "change; a rough guess",
+                                   slow_order, x.gain);
+            }
             s += fmt::format("| {} | {} | {} | {} |{} {} |\n", series, cell(x.extrapolated * m->display_scale, 6),
                              order_text(x.order),
                              cell(x.ratio, 4),
@@ -677,7 +684,7 @@ void write_study_markdown(const fs::path& file, const StudyReport& report, const
                 const auto& x = analysis.extrapolations.at({series, key});
                 const std::string order = order_text(x.order);
                 if (x.status == ConvergenceStatus::Converging) {
-                    s += fmt::format(" {} |", order);
+                    s += x.slow ? fmt::format(" {} (slow) |", order) : fmt::format(" {} |", order);
                 } else if (x.status == ConvergenceStatus::Diverging) {
                     s += fmt::format(" {} (diverging) |", order);
                 } else {

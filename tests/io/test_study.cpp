@@ -71,6 +71,24 @@ TEST(Richardson, UnequalRatiosAreSolvedForTheOrder) {
     }
 }
 
+TEST(Richardson, OrdersBelowOneHalfAreMarkedSlowWithTheirGain) {
+    // The gain is (f0 - f3) / (f3 - f2): checked against the exact series f0 + C h^p, where it is
+    // h3^p / (h2^p - h3^p) = 1 / ((h2/h3)^p - 1).
+    const std::vector<double> h{0.3, 0.2, 0.15};
+    for (double p : {0.15, 0.45, 0.55, 2.0}) {
+        const auto f = values_on(h, 7.9, 0.8, p);
+        const auto e = extrapolate(h, f);
+        ASSERT_EQ(e.status, ConvergenceStatus::Converging);
+        EXPECT_EQ(e.slow, p < slow_order) << "p " << p;
+        EXPECT_NEAR(e.gain, (7.9 - f[2]) / (f[2] - f[1]), 1e-9 * e.gain) << "p " << p;
+    }
+    // Not converging: never slow, no gain.
+    const auto d = extrapolate(h, values_on(h, 1.0, 1.0, -1.0));
+    ASSERT_EQ(d.status, ConvergenceStatus::Diverging);
+    EXPECT_FALSE(d.slow);
+    EXPECT_TRUE(std::isnan(d.gain));
+}
+
 TEST(Richardson, UsesTheThreeFinestSpacingsInAnyOrder) {
     const std::vector<double> h{0.25, 2.0, 0.5, 1.0};
     auto f = values_on(h, 3.0, 1.0, 2.0);
