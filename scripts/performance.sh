@@ -16,7 +16,7 @@ out=docs/performance/bench_steps.md
 {
   echo "# gpa_bench_steps, $(date -u +%Y-%m-%d) on $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | xargs), $(nproc) CPUs"
   echo
-  ./build/benchmarks/gpa_bench_steps --bandwidth --nodes 1e4,1e5,1e6 --threads 1,2 --steps 10 --repeat 3 --warmup 20
+  ./build/benchmarks/gpa_bench_steps --bandwidth --nodes 1e4,1e5,1e6 --threads 1,2 --steps 10 --repeat 5 --warmup 20
   ./build/benchmarks/gpa_bench_steps --case 2d-variable --case 3d-variable --case 2d-fixed --case 3d-fixed \
     --nodes 1e6 --threads 2 --memory --steps 1 --repeat 1 --warmup 0 | grep '^memory'
 } | tee "$out"

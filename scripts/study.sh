@@ -14,7 +14,7 @@
 #   elastic-bar            1, 1.5, 2.25     8, 12, 18 nodes across the radius (ratio 1.5)
 #   taylor-copper-190      2/3, 1, 4/3      10, 15, 20 (the spacings of tools/taylor_table.py)
 #   taylor-steel-208       2/3, 1, 4/3, 2   10, 15, 20, 30 (the steel bar comes to rest sooner)
-#   armco-cylinder-nodal   0.6, 0.9, 1.35   12, 18, 27 (ratio 1.5; the paper used 20)
+#   armco-cylinder-nodal   0.6, 0.9, 1.35, 2   12, 18, 27, 40 (the paper used 20)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
@@ -55,7 +55,7 @@ for scene in "${scenes[@]}"; do
     elastic-bar) args=(--refine 1,1.5,2.25 "${elastic_variants[@]}") ;;
     taylor-copper-*) args=(--refine 0.6666667,1,1.3333333 "${plastic_variants[@]}") ;;
     taylor-steel-*) args=(--refine 0.6666667,1,1.3333333,2 "${plastic_variants[@]}") ;;
-    armco-cylinder-nodal) args=(--refine 0.6,0.9,1.35 "${plastic_variants[@]}") ;;
+    armco-cylinder-nodal) args=(--refine 0.6,0.9,1.35,2 "${plastic_variants[@]}") ;;
     *) echo "study.sh: no study is defined for '$scene'" >&2; exit 2 ;;
   esac
   echo "== $scene"
