@@ -31,18 +31,6 @@ Scene read_scene(const std::optional<fs::path>& file) {
     return io::parse_scene(default_scene_text(), "built-in default scene (scenes/armco-cylinder-nodal.toml)");
 }
 
-std::string slug(const std::string& name) {
-    std::string s;
-    for (char c : name) s += std::isalnum(static_cast<unsigned char>(c)) ? c : '-';
-    return s.empty() ? "run" : s;
-}
-
-fs::path default_output(const Scene& scene) {
-    const std::time_t now = std::time(nullptr);
-    char stamp[32];
-    std::strftime(stamp, sizeof stamp, "%Y%m%d-%H%M%S", std::localtime(&now));
-    return fs::path("runs") / fmt::format("{}-{}", slug(scene.name), stamp);
-}
 
 // Snapshot times: every interval, or `count` spread over the end time; with neither known,
 // the first and the last.
@@ -103,7 +91,7 @@ void print_report(const Simulation& sim) {
 
 int run_scene(const RunOptions& options) {
     const Scene scene = read_scene(options.scene);
-    const fs::path output = options.output.value_or(default_output(scene));
+    const fs::path output = options.output.value_or(default_output_folder("runs", scene.name));
     const auto wall_start = std::chrono::steady_clock::now();
     Simulation sim(scene, options.threads);  // before the folder: an impossible scene leaves nothing behind
     io::RunFolder folder(output, options.overwrite);
@@ -166,6 +154,16 @@ int run_scene(const RunOptions& options) {
     }
     fmt::print("output: {} (open particles.pvd in ParaView; history.csv, summary.json)\n", folder.final_path().string());
     return 0;
+}
+
+fs::path default_output_folder(const std::string& root, const std::string& scene_name) {
+    std::string slug;
+    for (char c : scene_name) slug += std::isalnum(static_cast<unsigned char>(c)) ? c : '-';
+    if (slug.empty()) slug = "scene";
+    const std::time_t now = std::time(nullptr);
+    char stamp[32];
+    std::strftime(stamp, sizeof stamp, "%Y%m%d-%H%M%S", std::localtime(&now));
+    return fs::path(root) / fmt::format("{}-{}", slug, stamp);
 }
 
 int check_scene(const fs::path& file) {

@@ -25,6 +25,7 @@
 #include "gpa/io/scene_file.hpp"
 #include "gpa/io/study.hpp"
 #include "progress.hpp"
+#include "run.hpp"
 
 namespace gpa::app {
 
@@ -33,19 +34,6 @@ namespace {
 namespace fs = std::filesystem;
 
 constexpr double nan = std::numeric_limits<double>::quiet_NaN();
-
-std::string slug(const std::string& name) {
-    std::string s;
-    for (char c : name) s += std::isalnum(static_cast<unsigned char>(c)) ? c : '-';
-    return s.empty() ? "study" : s;
-}
-
-fs::path default_output(const Scene& scene) {
-    const std::time_t now = std::time(nullptr);
-    char stamp[32];
-    std::strftime(stamp, sizeof stamp, "%Y%m%d-%H%M%S", std::localtime(&now));
-    return fs::path("studies") / fmt::format("{}-{}", slug(scene.name), stamp);
-}
 
 // The process's memory as Linux reports it in /proc/self/status ("VmHWM:   1640 kB"), in bytes;
 // NaN where there is no such file or field.
@@ -237,7 +225,7 @@ int run_study(const StudyOptions& options) {
         }
     }
 
-    const fs::path output = options.output.value_or(default_output(scene));
+    const fs::path output = options.output.value_or(default_output_folder("studies", scene.name));
     io::RunFolder folder(output, options.overwrite);
     io::StudyReport report;
     report.scene_name = scene.name;

@@ -13,6 +13,20 @@ namespace gpa::io {
 
 namespace fs = std::filesystem;
 
+void write_text_file(const fs::path& file, std::string_view text) {
+    auto tmp = file;
+    tmp += ".tmp";
+    {
+        std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+        out << text;
+        out.flush();
+        if (!out) throw OutputError(fmt::format("cannot write '{}'", tmp.string()));
+    }
+    std::error_code ec;
+    fs::rename(tmp, file, ec);
+    if (ec) throw OutputError(fmt::format("cannot rename '{}' to '{}': {}", tmp.string(), file.string(), ec.message()));
+}
+
 RunFolder::RunFolder(fs::path folder, bool overwrite) : final_(std::move(folder)), overwrite_(overwrite) {
     if (final_.empty()) throw OutputError("the output folder name is empty");
     if (final_.filename().empty()) final_ = final_.parent_path();  // "out/" -> "out"
@@ -187,16 +201,7 @@ void write_summary(const fs::path& file, const Simulation& sim, const RunSummary
     field("node_steps_per_second", json_number(stepping > 0.0 ? sim.node_steps() / stepping : 0.0));
     field("snapshots", std::to_string(run.snapshots), true);
     j += "}\n";
-    auto tmp = file;
-    tmp += ".tmp";
-    {
-        std::ofstream out(tmp);
-        out << j;
-        if (!out) throw OutputError(fmt::format("cannot write '{}'", tmp.string()));
-    }
-    std::error_code ec;
-    fs::rename(tmp, file, ec);
-    if (ec) throw OutputError(fmt::format("cannot rename '{}': {}", tmp.string(), ec.message()));
+    write_text_file(file, j);
 }
 
 void write_profile(const fs::path& file, const Simulation& sim) {
@@ -238,20 +243,12 @@ void write_profile(const fs::path& file, const Simulation& sim) {
         const auto k = static_cast<std::size_t>(std::clamp(h / bin, 0.0, double(bins - 1)));
         radius[k] = std::max(radius[k], r + 0.5 * n.diameter[i]);
     }
-    auto tmp = file;
-    tmp += ".tmp";
-    {
-        std::ofstream out(tmp);
-        out << "height_m,radius_m\n";
-        for (std::size_t k = 0; k < bins; ++k) {
-            if (radius[k] >= 0.0) out << fmt::format("{:.6e},{:.6e}\n", (double(k) + 0.5) * bin, radius[k]);
-        }
-        out << fmt::format("{:.6e},{:.6e}\n", top, 0.0);
-        if (!out) throw OutputError(fmt::format("cannot write '{}'", tmp.string()));
+    std::string text = "height_m,radius_m\n";
+    for (std::size_t k = 0; k < bins; ++k) {
+        if (radius[k] >= 0.0) text += fmt::format("{:.6e},{:.6e}\n", (double(k) + 0.5) * bin, radius[k]);
     }
-    std::error_code ec;
-    fs::rename(tmp, file, ec);
-    if (ec) throw OutputError(fmt::format("cannot rename '{}': {}", tmp.string(), ec.message()));
+    text += fmt::format("{:.6e},{:.6e}\n", top, 0.0);
+    write_text_file(file, text);
 }
 
 }  // namespace gpa::io

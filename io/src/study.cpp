@@ -156,19 +156,6 @@ std::string memory_mb(double bytes) { return std::isfinite(bytes) ? fmt::format(
 
 double bytes_per_node(const StudyCase& c) { return c.nodes > 0 ? c.case_bytes / double(c.nodes) : nan; }
 
-void write_text_file(const fs::path& file, const std::string& text) {
-    auto tmp = file;
-    tmp += ".tmp";
-    {
-        std::ofstream out(tmp);
-        out << text;
-        if (!out) throw OutputError(fmt::format("cannot write '{}'", tmp.string()));
-    }
-    std::error_code ec;
-    fs::rename(tmp, file, ec);
-    if (ec) throw OutputError(fmt::format("cannot rename '{}': {}", tmp.string(), ec.message()));
-}
-
 const std::map<std::string, CaseErrors>& errors_of(const StudyAnalysis& a, std::size_t k) {
     static const std::map<std::string, CaseErrors> none;
     return k < a.errors.size() ? a.errors[k] : none;

@@ -212,16 +212,7 @@ std::string loglog_svg(const LogLogFigure& figure) {
 }
 
 void write_loglog_svg(const std::filesystem::path& file, const LogLogFigure& figure) {
-    auto tmp = file;
-    tmp += ".tmp";
-    {
-        std::ofstream out(tmp);
-        out << loglog_svg(figure);
-        if (!out) throw OutputError(fmt::format("cannot write '{}'", tmp.string()));
-    }
-    std::error_code ec;
-    std::filesystem::rename(tmp, file, ec);
-    if (ec) throw OutputError(fmt::format("cannot rename '{}': {}", tmp.string(), ec.message()));
+    write_text_file(file, loglog_svg(figure));
 }
 
 }  // namespace gpa::io

@@ -9,6 +9,7 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "gpa/engine/simulation.hpp"
@@ -20,6 +21,10 @@ class OutputError : public std::runtime_error {
 public:
     using std::runtime_error::runtime_error;
 };
+
+// Writes `text` to file.tmp and renames it to `file`, so that `file` is either the old one or the
+// whole new one. Throws OutputError naming the file when either step fails.
+void write_text_file(const std::filesystem::path& file, std::string_view text);
 
 class RunFolder {
 public:
