@@ -4,12 +4,10 @@
 #include <cctype>
 #include <charconv>
 #include <cmath>
-#include <fstream>
 #include <numeric>
 #include <optional>
 #include <set>
 #include <stdexcept>
-#include <system_error>
 
 #include <fmt/format.h>
 
@@ -205,9 +203,13 @@ double observed_order(double h1, double h2, double h3, double f1, double f2, dou
     return 0.5 * (lo + hi);
 }
 
+double richardson_gain(double h2, double h3, double order) {
+    if (std::isinf(order) && order > 0.0) return 0.0;
+    return 1.0 / std::expm1(order * std::log(h2 / h3));
+}
+
 double richardson_limit(double h2, double h3, double f2, double f3, double order) {
-    if (std::isinf(order) && order > 0.0) return f3;
-    return f3 + (f3 - f2) / std::expm1(order * std::log(h2 / h3));
+    return f3 + (f3 - f2) * richardson_gain(h2, h3, order);
 }
 
 Extrapolation extrapolate(std::span<const double> spacing, std::span<const double> value) {
@@ -246,9 +248,9 @@ Extrapolation extrapolate(std::span<const double> spacing, std::span<const doubl
         e.status = ConvergenceStatus::Diverging;
     } else {
         e.status = ConvergenceStatus::Converging;
+        e.gain = richardson_gain(h2, h3, e.order);
         e.extrapolated = richardson_limit(h2, h3, f2, f3, e.order);
         e.slow = e.order < slow_order;
-        e.gain = std::isinf(e.order) ? 0.0 : 1.0 / std::expm1(e.order * std::log(h2 / h3));
     }
     return e;
 }

@@ -72,6 +72,10 @@ inline constexpr double slow_order = 0.5;
 // +inf. Throws std::invalid_argument unless h1 > h2 > h3 > 0.
 double observed_order(double h1, double h2, double h3, double f1, double f2, double f3);
 
+// 1 / ((h2/h3)^p - 1), 0 for p = +inf: the factor by which the Richardson step multiplies the
+// last change f3 - f2 (Extrapolation::gain).
+double richardson_gain(double h2, double h3, double order);
+
 // f0 = f3 + (f3 - f2) / ((h2/h3)^p - 1): the limit h -> 0 of f0 + C h^p through (h2, f2), (h3, f3).
 double richardson_limit(double h2, double h3, double f2, double f3, double order);
 
