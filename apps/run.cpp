@@ -31,7 +31,6 @@ Scene read_scene(const std::optional<fs::path>& file) {
     return io::parse_scene(default_scene_text(), "built-in default scene (scenes/armco-cylinder-nodal.toml)");
 }
 
-
 // Snapshot times: every interval, or `count` spread over the end time; with neither known,
 // the first and the last.
 double snapshot_interval(const Scene& s) {

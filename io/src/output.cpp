@@ -13,20 +13,6 @@ namespace gpa::io {
 
 namespace fs = std::filesystem;
 
-void write_text_file(const fs::path& file, std::string_view text) {
-    auto tmp = file;
-    tmp += ".tmp";
-    {
-        std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-        out << text;
-        out.flush();
-        if (!out) throw OutputError(fmt::format("cannot write '{}'", tmp.string()));
-    }
-    std::error_code ec;
-    fs::rename(tmp, file, ec);
-    if (ec) throw OutputError(fmt::format("cannot rename '{}' to '{}': {}", tmp.string(), file.string(), ec.message()));
-}
-
 RunFolder::RunFolder(fs::path folder, bool overwrite) : final_(std::move(folder)), overwrite_(overwrite) {
     if (final_.empty()) throw OutputError("the output folder name is empty");
     if (final_.filename().empty()) final_ = final_.parent_path();  // "out/" -> "out"

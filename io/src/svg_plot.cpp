@@ -2,12 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
-#include <system_error>
 
 #include <fmt/format.h>
 
-#include "gpa/io/output.hpp"
+#include "gpa/io/atomic_file.hpp"
 
 namespace gpa::io {
 

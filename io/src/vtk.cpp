@@ -9,6 +9,8 @@
 
 #include <fmt/format.h>
 
+#include "gpa/io/atomic_file.hpp"
+
 namespace gpa::io {
 
 double von_mises_stress(const NodeStore& nodes, std::size_t i) {
@@ -35,21 +37,6 @@ struct Array {
 std::function<double(std::size_t, int)> vector_field(const NodeStore& nodes, const std::array<std::vector<double>, 3>& f) {
     const int dim = nodes.dim();
     return [&f, dim](std::size_t i, int c) { return c < dim ? f[c][i] : 0.0; };
-}
-
-void write_file_atomically(const std::filesystem::path& path, const std::function<void(std::ofstream&)>& body) {
-    auto tmp = path;
-    tmp += ".tmp";
-    {
-        std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-        if (!out) throw std::runtime_error(fmt::format("cannot open '{}' for writing", tmp.string()));
-        body(out);
-        out.flush();
-        if (!out) throw std::runtime_error(fmt::format("writing '{}' failed (disk full?)", tmp.string()));
-    }
-    std::error_code ec;
-    std::filesystem::rename(tmp, path, ec);
-    if (ec) throw std::runtime_error(fmt::format("cannot rename '{}' to '{}': {}", tmp.string(), path.string(), ec.message()));
 }
 
 }  // namespace

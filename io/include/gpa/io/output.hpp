@@ -9,22 +9,13 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
-#include <string_view>
 #include <vector>
 
 #include "gpa/engine/simulation.hpp"
+#include "gpa/io/atomic_file.hpp"
 #include "gpa/io/vtk.hpp"
 
 namespace gpa::io {
-
-class OutputError : public std::runtime_error {
-public:
-    using std::runtime_error::runtime_error;
-};
-
-// Writes `text` to file.tmp and renames it to `file`, so that `file` is either the old one or the
-// whole new one. Throws OutputError naming the file when either step fails.
-void write_text_file(const std::filesystem::path& file, std::string_view text);
 
 class RunFolder {
 public:
