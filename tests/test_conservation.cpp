@@ -1,6 +1,7 @@
 // Momentum and energy of the pairwise forces (spec section 5) for random stresses and
 // velocities on jittered lattices with unequal diameters, and the sign of the hoop term.
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -186,13 +187,14 @@ void check_energy(const ForceCase& s, const BondViscosityParameters* bond, bool 
                 }
                 al_dv = (N * l).dot(dv);
                 const double h = a * 0.5 * (n.diameter[i] + n.diameter[j]);
+                // Lattice pairs (fixed centre and neighbour) weigh R(min(r/h, 1.8)) (spec section 2,
+                // lattice weights), all others R(r/h).
+                const bool lattice = s.connectivity == Connectivity::Fixed && n.connectivity[j] == Connectivity::Fixed;
+                const double q = lattice ? std::min(r / h, 1.8) : r / h;
                 double R = 0.0;
-                if (s.connectivity == Connectivity::Fixed) {
-                    R = 1.0;
-                } else if (s.weight == WeightKind::Gpa) {
-                    R = 1.0 - r / (2.0 * h);
+                if (s.weight == WeightKind::Gpa) {
+                    R = 1.0 - q / 2.0;
                 } else {
-                    const double q = r / h;
                     R = q < 1.0 ? 3.0 * q * q - 2.25 * q * q * q : 0.75 * q * (2.0 - q) * (2.0 - q);
                 }
                 const double mu = h * dvdx / (r2 + bond->eps0 * h * h);

@@ -103,6 +103,7 @@ std::size_t fill_lattice(NodeStore& nodes, const LatticeBlock& block) {
         const auto& p = centres[k];
         for (int c = 0; c < dim; ++c) {
             nodes.position[c][i] = p[c];
+            nodes.initial_position[c][i] = p[c];
             nodes.velocity[c][i] = block.velocity[c];
         }
         double v0 = cell_volume;
@@ -119,7 +120,6 @@ std::size_t fill_lattice(NodeStore& nodes, const LatticeBlock& block) {
         nodes.mass[i] = block.density * v0;
         nodes.initial_diameter[i] = d0;
         nodes.diameter[i] = d0;
-        nodes.initial_radius[i] = p[0];
         nodes.body[i] = block.body;
         nodes.material[i] = block.material;
         nodes.connectivity[i] = block.connectivity;

@@ -134,7 +134,11 @@ void find_neighbours(const NodeStore& nodes, double a, std::size_t centres, Comp
     const auto visit = [&](std::size_t i, auto&& emit) {
         const bool fixed = nodes.connectivity[i] == Connectivity::Fixed;
         if (fixed) {
-            for (NodeIndex j : nodes.fixed_neighbours.row(i)) emit(j);
+            // Lattice pairs link two fixed nodes; a lattice neighbour that has switched is a
+            // variable pair now, found below like any other (spec section 2, mixed pairs).
+            for (NodeIndex j : nodes.fixed_neighbours.row(i)) {
+                if (nodes.connectivity[j] == Connectivity::Fixed) emit(j);
+            }
             if (extra_fixed) {
                 for (NodeIndex j : extra_fixed->row(i)) emit(j);
             }
@@ -154,7 +158,7 @@ void find_neighbours(const NodeStore& nodes, double a, std::size_t centres, Comp
                     const std::size_t cell = grid.linear(c);
                     for (std::size_t k = grid.cell_start[cell]; k < grid.cell_start[cell + 1]; ++k) {
                         const NodeIndex j = grid.nodes[k];
-                        if (j == i || (fixed && nodes.body[j] == own_body)) continue;
+                        if (j == i || (fixed && nodes.body[j] == own_body && nodes.connectivity[j] == Connectivity::Fixed)) continue;
                         if (skin > 0.0 ? is_candidate(nodes, a, skin, i, j) : is_pair(nodes, a, i, j)) emit(j);
                     }
                 }
@@ -265,12 +269,13 @@ CompressedRows find_neighbours_brute_force(const NodeStore& nodes, double a, std
     for (std::size_t i = 0; i < centres; ++i) {
         const bool fixed = nodes.connectivity[i] == Connectivity::Fixed;
         if (fixed) {
-            const auto row = nodes.fixed_neighbours.row(i);
-            rows[i].assign(row.begin(), row.end());
+            for (NodeIndex j : nodes.fixed_neighbours.row(i)) {
+                if (nodes.connectivity[j] == Connectivity::Fixed) rows[i].push_back(j);
+            }
             if (extra_fixed) rows[i].insert(rows[i].end(), extra_fixed->row(i).begin(), extra_fixed->row(i).end());
         }
         for (std::size_t j = 0; j < nodes.size(); ++j) {
-            if (j == i || (fixed && nodes.body[j] == nodes.body[i])) continue;
+            if (j == i || (fixed && nodes.body[j] == nodes.body[i] && nodes.connectivity[j] == Connectivity::Fixed)) continue;
             if (is_pair(nodes, a, i, j)) rows[i].push_back(static_cast<NodeIndex>(j));
         }
     }

@@ -29,6 +29,7 @@ void NodeStore::for_each_field(F&& f) {
     const int d = dim_;
     for (int c = 0; c < d; ++c) {
         f(position[c]);
+        f(initial_position[c]);
         f(velocity[c]);
         f(alpha[c]);
         f(force[c]);
@@ -42,7 +43,6 @@ void NodeStore::for_each_field(F&& f) {
     f(size_weight);
     f(diameter);
     f(initial_diameter);
-    f(initial_radius);
     f(volumetric_strain);
     f(pressure);
     f(viscous_pressure);

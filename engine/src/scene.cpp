@@ -258,6 +258,9 @@ void check_solver(const SolverOptions& s) {
         s.smoothing != SmoothingMode::Tension) {
         fail("solver.smoothing: unknown smoothing mode");
     }
+    if (!(s.hourglass_coefficient >= 0.0 && s.hourglass_coefficient <= 1.0)) {
+        fail(fmt::format("solver.hourglass_coefficient = {} is outside [0, 1]", s.hourglass_coefficient));
+    }
     if (!(s.smoothing_coefficient >= 0.0 && s.smoothing_coefficient < 1.0)) {
         fail(fmt::format("solver.smoothing_coefficient = {} is outside [0, 1)", s.smoothing_coefficient));
     }

@@ -15,6 +15,7 @@
 #include "gpa/engine/drivers.hpp"
 #include "gpa/engine/errors.hpp"
 #include "gpa/engine/ghosts.hpp"
+#include "gpa/engine/hourglass.hpp"
 #include "gpa/engine/kernels.hpp"
 #include "gpa/engine/neighbours.hpp"
 #include "gpa/engine/parallel.hpp"
@@ -87,6 +88,9 @@ struct Simulation::Impl {
     ScatterPlan plan;
     SmoothingScratch smoothing_scratch;
     std::vector<double> bond_power;
+    bool with_hourglass = false;         // C_hg > 0
+    std::vector<double> hourglass_power; // per centre, the power of its hourglass-control forces
+    double hourglass_work = 0.0;
     std::vector<double> largest_bond_q;  // per centre, the largest Q_ij of its pairs (for the time step)
     bool failed = false;                 // a phase threw: the state is half-updated
     std::unique_ptr<PhaseGraph> graph;
@@ -211,6 +215,7 @@ void Simulation::Impl::setup() {
                      std::none_of(body_mode.begin(), body_mode.end(),
                                   [](ConnectivityMode m) { return m == ConnectivityMode::Automatic; });
     with_skin = scene.solver.neighbour_skin > 0.0 && !lists_constant;
+    with_hourglass = scene.solver.hourglass_coefficient > 0.0;
 
     // Geometry, neighbours, geometry factors and forces at t = 0; then the first half step.
     geometry<G>();
@@ -295,7 +300,7 @@ void Simulation::Impl::geometry() {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, real, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
         for (std::size_t i = r.begin(); i != r.end(); ++i) {
             nodes.diameter[i] = node_diameter<G>(nodes.initial_diameter[i], nodes.volumetric_strain[i],
-                                                 nodes.initial_radius[i], nodes.position[0][i]);
+                                                 nodes.initial_position[0][i], nodes.position[0][i]);
         }
         update_size_weights(nodes, r.begin(), r.end());
     });
@@ -413,7 +418,9 @@ void Simulation::Impl::search_candidates() {
     unconditional.assign(real, 0);
     for (std::size_t i = 0; i < real; ++i) {
         if (nodes.connectivity[i] != Connectivity::Fixed) continue;
-        unconditional[i] = static_cast<std::uint32_t>(nodes.fixed_neighbours.row(i).size() + (mirrored ? mirrored->row(i).size() : 0));
+        std::uint32_t lattice = 0;
+        for (NodeIndex j : nodes.fixed_neighbours.row(i)) lattice += nodes.connectivity[j] == Connectivity::Fixed;
+        unconditional[i] = lattice + static_cast<std::uint32_t>(mirrored ? mirrored->row(i).size() : 0);
     }
     for (int c = 0; c < dim(); ++c) searched_position[c].assign(nodes.position[c].begin(), nodes.position[c].begin() + real);
     searched_diameter.assign(nodes.diameter.begin(), nodes.diameter.begin() + real);
@@ -560,6 +567,11 @@ void Simulation::Impl::forces() {
         f.largest_bond_viscosity = largest_bond_q.data();
     }
     compute_forces<G>(lists, plan, scene.solver.weight, with_bond ? &bond : nullptr, f, nodes.size());
+    if (with_hourglass) {
+        hourglass_power.assign(nodes.size(), 0.0);
+        apply_hourglass_control<G::dim>(lists, plan, hourglass_fields<G::dim>(nodes, scene.solver.switch_plastic_strain, hourglass_power.data()), real,
+                                        scene.solver.hourglass_coefficient);
+    }
     if (!ghosts.empty()) {
         const auto all = ghosts.normal_reactions(nodes, real);
         for (std::size_t k = 0; k < rigid_planes.size(); ++k) reaction[k] = all[rigid_planes[k]];
@@ -586,6 +598,22 @@ void Simulation::Impl::integrate(double dt_avg) {
                 nodes.viscous_work[i] += heat;
             }
         });
+    }
+    if (with_hourglass) {
+        // The power the hourglass-control forces dissipate becomes heat of their centre, the same
+        // booking as bond viscosity (kernels.hpp: it is <= 0 pair by pair).
+        hourglass_work += tbb::parallel_deterministic_reduce(
+            tbb::blocked_range<std::size_t>(0, real, reduce_grain), 0.0,
+            [&](const tbb::blocked_range<std::size_t>& r, double sum) {
+                for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                    const double heat = -hourglass_power[i] * dt_avg;
+                    nodes.internal_energy[i] += heat / nodes.mass[i];
+                    nodes.viscous_work[i] += heat / nodes.mass[i];
+                    sum += heat;
+                }
+                return sum;
+            },
+            [](double x, double y) { return x + y; });
     }
 }
 
@@ -641,6 +669,7 @@ void Simulation::Impl::sum_totals() {
     totals.internal_energy = s.internal;
     totals.plastic_work = s.plastic;
     totals.viscous_work = s.viscous;
+    totals.hourglass_work = hourglass_work;
     totals.boundary_work = boundary_work;
     totals.momentum = s.momentum;
     totals.time = time;

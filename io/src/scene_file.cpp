@@ -34,7 +34,7 @@ const std::vector<std::string_view> body_keys{
 const std::vector<std::string_view> plane_keys{"name", "kind", "axis", "position", "side", "lift_off"};
 const std::vector<std::string_view> solver_keys{
     "connectivity", "switch_plastic_strain", "influence_distance", "weight",          "viscosity",
-    "normalisation", "viscosity_linear", "viscosity_quadratic", "bond_viscosity_eps0", "smoothing",     "smoothing_coefficient",
+    "normalisation", "viscosity_linear", "viscosity_quadratic", "bond_viscosity_eps0", "hourglass_coefficient", "smoothing",     "smoothing_coefficient",
     "cfl",          "alpha_limit",           "max_time_step",      "time_step_growth", "failure",
     "scatter",      "reorder_interval",      "neighbour_skin",
 };
@@ -308,6 +308,7 @@ SolverOptions read_solver(const Reporter& reporter, const toml::table& table) {
     if (const auto v = r.quantity("viscosity_linear", D::Dimensionless)) s.viscosity_linear = *v;
     if (const auto v = r.quantity("viscosity_quadratic", D::Dimensionless)) s.viscosity_quadratic = *v;
     if (const auto v = r.quantity("bond_viscosity_eps0", D::Dimensionless)) s.bond_viscosity_eps0 = *v;
+    if (const auto v = r.quantity("hourglass_coefficient", D::Dimensionless)) s.hourglass_coefficient = *v;
     if (const auto v = r.choice<SmoothingMode>("smoothing", {{"off", SmoothingMode::Off},
                                                              {"everywhere", SmoothingMode::Everywhere},
                                                              {"tension", SmoothingMode::Tension}})) {

@@ -94,6 +94,7 @@ TEST(SceneFormatDoc, DefaultsAreThoseOfSceneHpp) {
     expect_number(doc, "viscosity_quadratic", s.viscosity_quadratic);
     expect_number(doc, "bond_viscosity_eps0", s.bond_viscosity_eps0);
     expect_word(doc, "smoothing", word(s.smoothing));
+    expect_number(doc, "hourglass_coefficient", s.hourglass_coefficient);
     expect_number(doc, "smoothing_coefficient", s.smoothing_coefficient);
     expect_number(doc, "cfl", s.cfl);
     expect_number(doc, "alpha_limit", s.alpha_limit);
@@ -114,9 +115,9 @@ TEST(SceneFormatDoc, DefaultsAreThoseOfSceneHpp) {
     expect_number(doc, "snapshot_interval", o.snapshot_interval);
     expect_number(doc, "history_every", static_cast<double>(o.history_every));
 
-    // 19 solver options, 3 stop criteria, 3 output options, and no row for an option that does
+    // 20 solver options, 3 stop criteria, 3 output options, and no row for an option that does
     // not exist.
-    EXPECT_EQ(doc.size(), 25u) << "rows in [solver], [stop] and [output] of docs/scene-format.md";
+    EXPECT_EQ(doc.size(), 26u) << "rows in [solver], [stop] and [output] of docs/scene-format.md";
 }
 
 }  // namespace

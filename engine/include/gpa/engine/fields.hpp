@@ -3,6 +3,7 @@
 // its view, so its data dependencies are visible; the views are made from a NodeStore by the
 // functions below, or by hand in an embedding program with its own storage.
 
+#include <algorithm>
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -29,8 +30,14 @@ struct PairFields {
         return p;
     }
 
-    // Pair geometry of centre i and neighbour j. A fixed-connectivity centre uses R = 1 for its
-    // lattice neighbours (same body); every other pair uses the variable weight (Eq. 1b or 62-65).
+    // Two fixed-connectivity nodes of one body form a lattice pair (spec section 2).
+    bool lattice_pair(std::size_t i, std::size_t j) const {
+        return connectivity[i] == Connectivity::Fixed && connectivity[j] == Connectivity::Fixed && body[i] == body[j];
+    }
+
+    // Pair geometry of centre i and neighbour j. Every pair weighs R(r / h) (Eq. 1b or 62-65); a
+    // lattice pair R(min(r / h, lattice_weight_reach)), so that it is never lost however far its
+    // nodes move apart (spec section 2, "[spec] Lattice weights"; the paper's Eq. 1a has R = 1).
     // r = 0 (coincident nodes) is returned as is; the drivers report it.
     template <class VariableWeight>
     PairGeometry<D> pair(std::size_t i, std::size_t j) const {
@@ -41,8 +48,8 @@ struct PairFields {
         p.inv_r = 1.0 / p.r;
         p.l = dx * p.inv_r;
         p.h = pair_smoothing_length(influence_distance, diameter[i], diameter[j]);
-        const bool lattice_pair = connectivity[i] == Connectivity::Fixed && body[i] == body[j];
-        p.R = lattice_pair ? fixed_pair_weight : VariableWeight::value(p.r / p.h);
+        const double v = p.r / p.h;
+        p.R = VariableWeight::value(lattice_pair(i, j) ? std::min(v, lattice_weight_reach) : v);
         return p;
     }
 };

@@ -129,6 +129,50 @@ inline double advance_volumetric_strain(double eps_v, double rate, double dt) {
     return eps_v + rate * dt * (1.0 + eps_v);
 }
 
+// Zero-energy-mode control of fixed-connectivity centres (spec section 2, "[spec] Hourglass
+// control"). With R = 1 on a lattice stencil, a velocity field that alternates from row to row
+// (v_j equal for the neighbours on both sides of i) gives sum_j W (v_j - v_i) l_b / r = 0 in
+// Eq. 7-8: no strain rate, no stress, no restoring force. The control measures, for each lattice
+// pair, how far the velocity difference departs from the best affine fit around the centre,
+//   e_ij = (v_j - v_i) - Lfit_i (x_j - x_i),   Lfit_i = [sum_j w_j dv_j r_j^T] [sum_j w_j r_j r_j^T]^-1,
+// with w_j = W_j / r_ij^2, and damps it with equal and opposite pair forces
+//   F_j = - kappa_i w_j e_ij / sum_k w_k,   F_i = - sum_j F_j,   kappa_i = C_hg M_i c_i / h_i.
+// e_ij = 0 for every affine velocity field, on any neighbourhood (so rigid motion, uniform strain
+// and rotation feel nothing), and because Lfit is the weighted least-squares fit,
+// sum_j w_j e_ij r_j^T = 0, so the power of the forces is
+//   sum_j F_j . (v_j - v_i) = - kappa_i sum_j w_j |e_ij|^2 / sum_k w_k <= 0:
+// they only dissipate, and that power is booked as heat of the centre.
+template <int D>
+struct HourglassFit {
+    Mat<D> moment = Mat<D>::Zero();      // sum_j w_j r_j r_j^T
+    Mat<D> difference = Mat<D>::Zero();  // sum_j w_j (v_j - v_i) r_j^T
+    double weight = 0.0;                 // sum_j w_j
+};
+
+// One lattice neighbour's contribution to the fit: r = x_j - x_i, dv = v_j - v_i, w = W_j / r^2.
+template <int D>
+inline void accumulate_hourglass_fit(const Vec<D>& r, const Vec<D>& dv, double w, HourglassFit<D>& fit) {
+    fit.moment.noalias() += w * r * r.transpose();
+    fit.difference.noalias() += w * dv * r.transpose();
+    fit.weight += w;
+}
+
+// The weight of a lattice pair in the fit and the force: w = W_j / r^2.
+inline double hourglass_pair_weight(double size_weight_j, double r_squared) { return size_weight_j / r_squared; }
+
+// kappa_i = C_hg M_i c_i / h_i: a damping rate c_i / h_i (the inverse of the time sound takes to
+// cross the node) times the node's mass.
+inline double hourglass_damping(double coefficient, double mass, double sound_speed, double h) {
+    return coefficient * mass * sound_speed / h;
+}
+
+// e_ij = (v_j - v_i) - Lfit_i r_j: the part of a lattice pair's velocity difference that no
+// affine field around the centre explains.
+template <int D>
+inline Vec<D> hourglass_velocity_error(const Mat<D>& fitted_gradient, const Vec<D>& r, const Vec<D>& dv) {
+    return dv - fitted_gradient * r;
+}
+
 // Eq. 3 and its plane-strain and 3D analogues (spec section 2):
 //   axisymmetric d = d0 sqrt((1 + eps_v) x0 / x), plane strain d = d0 sqrt(1 + eps_v),
 //   3D d = d0 (1 + eps_v)^(1/3).

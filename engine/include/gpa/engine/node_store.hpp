@@ -36,6 +36,9 @@ public:
 
     // --- state carried from step to step -------------------------------------------------
     std::array<std::vector<double>, 3> position;   // m
+    // Position on the initial lattice, m: x0 of Eq. 3, and the lattice distances r0 that weigh
+    // fixed-connectivity pairs (spec section 2).
+    std::array<std::vector<double>, 3> initial_position;
     std::array<std::vector<double>, 3> velocity;   // m/s
     std::vector<double> mass;                      // kg (a ring's mass in axisymmetric geometry)
     std::vector<double> volume;                    // V, m^3 (unit thickness in plane strain)
@@ -43,7 +46,6 @@ public:
     std::vector<double> size_weight;               // W_j: A_j in 2D (Eq. 4), V_j in 3D
     std::vector<double> diameter;                  // d (Eq. 3)
     std::vector<double> initial_diameter;          // d0
-    std::vector<double> initial_radius;            // x0, axisymmetric only (Eq. 3)
     std::vector<double> volumetric_strain;         // eps_v = V/V0 - 1 (Eq. 13)
     std::array<std::vector<double>, 6> deviatoric_stress;  // s, Pa
     std::vector<double> pressure;                  // P from the equation of state, Pa

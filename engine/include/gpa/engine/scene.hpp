@@ -99,6 +99,9 @@ struct SolverOptions {
     double viscosity_linear = 0.2;     // C_L (Eq. 36, 37)
     double viscosity_quadratic = 4.0;  // C_Q
     double bond_viscosity_eps0 = 0.01; // Eq. 38
+    // C_hg of the zero-energy-mode control of fixed-connectivity centres (kernels.hpp, spec
+    // section 2): 0 = off. It acts only on fixed nodes (fixed and automatic bodies).
+    double hourglass_coefficient = 0.05;
     SmoothingMode smoothing = SmoothingMode::Off;
     double smoothing_coefficient = 0.1;  // C_cs (Eq. 67)
     // C_cfl of the stable time step (spec section 11). The largest value found stable: 0.6 (the

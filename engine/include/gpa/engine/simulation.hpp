@@ -42,7 +42,8 @@ struct Totals {
     double kinetic_energy = 0.0;   // J
     double internal_energy = 0.0;  // sum M e, J (includes plastic, viscous and smoothing heat)
     double plastic_work = 0.0;     // sum M w_p, J
-    double viscous_work = 0.0;     // work of artificial viscosity (nodal and bond), J
+    double viscous_work = 0.0;     // work of artificial viscosity (nodal, bond and hourglass control), J
+    double hourglass_work = 0.0;   // the part of viscous_work done by the hourglass control of fixed nodes, J
     double boundary_work = 0.0;    // energy removed by velocity constraints, J
     double initial_kinetic_energy = 0.0;  // J
     double initial_energy = 0.0;   // kinetic + internal at t = 0, J

@@ -4,14 +4,17 @@
 
 namespace gpa {
 
-// The weight used by variable-connectivity pairs; fixed pairs always use R = 1 (Eq. 1a).
+// The distance weight of every pair (Eq. 1b or 62-65). Fixed-connectivity (lattice) pairs use the
+// same function, at v = r/h but never beyond lattice_weight_reach, so that a lattice pair keeps a
+// weight however far apart its nodes move (spec section 2, "[spec] Lattice weights"; the paper's
+// Eq. 1a has R = 1).
 enum class WeightKind {
     Gpa,     // R = 1 - v/2 (Eq. 1b)
     SphNsf,  // R = -r W'(r, h) of a cubic-spline kernel (Eq. 62-65)
 };
 
-// Eq. 1a: fixed connectivity.
-inline constexpr double fixed_pair_weight = 1.0;
+// v at which a lattice pair's weight stops falling: R(1.8) = 0.1 for the GPA weight.
+inline constexpr double lattice_weight_reach = 1.8;
 
 // Eq. 1b: R = 1 - v/2 for v = r/h in [0, 2), zero beyond (a neighbour at exactly 2h has weight 0).
 struct GpaWeight {

@@ -1,0 +1,51 @@
+#pragma once
+// Zero-energy-mode ("hourglass") control of fixed-connectivity centres (kernels.hpp,
+// spec section 2): pair forces that damp the part of the lattice pairs' velocity differences no
+// affine field explains. They conserve momentum (equal and opposite), vanish for every affine
+// velocity field, and only dissipate; each centre's dissipated power is returned so that the
+// integrator books it as the centre's heat.
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+
+#include "gpa/engine/colouring.hpp"
+#include "gpa/engine/compressed_rows.hpp"
+#include "gpa/engine/node_store.hpp"
+
+namespace gpa {
+
+template <int D>
+struct HourglassFields {
+    std::array<const double*, D> position{};
+    std::array<const double*, D> velocity{};
+    const double* size_weight = nullptr;  // W_j
+    const double* mass = nullptr;
+    const double* sound_speed = nullptr;
+    const double* smallest_h = nullptr;   // h_i of the damping rate c_i / h_i
+    const Connectivity* connectivity = nullptr;
+    const std::int32_t* body = nullptr;
+    const double* plastic_strain = nullptr;
+    // Variable-connectivity centres are controlled while their equivalent plastic strain is below
+    // this (the lattice regime, where the mode lives: see apply_hourglass_control); fixed ones always.
+    double lattice_plastic_strain = 0.0;
+    // outputs
+    std::array<double*, D> force{};  // added to
+    double* power = nullptr;         // per centre: the power of its control forces (<= 0), W
+};
+
+template <int D>
+HourglassFields<D> hourglass_fields(NodeStore& nodes, double lattice_plastic_strain, double* power);
+
+// Adds the control forces of the controlled centres in [0, real_count) over their pairs with real
+// neighbours of their own body (ghosts and other bodies take no part) to f.force, by the colours
+// of `plan` (a conflict-free plan of `lists`), and writes each centre's power (0 for the others).
+// Controlled centres: every fixed-connectivity node, whose lattice stencil has the exact
+// zero-energy mode, and every variable-connectivity node still in the lattice regime (plastic
+// strain below f.lattice_plastic_strain), whose neighbourhood is still the regular lattice and
+// carries the same mode nearly undamped (docs/connectivity.md). coefficient: C_hg > 0.
+template <int D>
+void apply_hourglass_control(const CompressedRows& lists, const ScatterPlan& plan, const HourglassFields<D>& f,
+                             std::size_t real_count, double coefficient);
+
+}  // namespace gpa

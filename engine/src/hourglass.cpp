@@ -1,0 +1,96 @@
+#include "gpa/engine/hourglass.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <Eigen/LU>
+
+#include "gpa/engine/kernels.hpp"
+
+namespace gpa {
+
+template <int D>
+HourglassFields<D> hourglass_fields(NodeStore& nodes, double lattice_plastic_strain, double* power) {
+    HourglassFields<D> f;
+    for (int c = 0; c < D; ++c) {
+        f.position[c] = nodes.position[c].data();
+        f.velocity[c] = nodes.velocity[c].data();
+        f.force[c] = nodes.force[c].data();
+    }
+    f.size_weight = nodes.size_weight.data();
+    f.mass = nodes.mass.data();
+    f.sound_speed = nodes.sound_speed.data();
+    f.smallest_h = nodes.smallest_h.data();
+    f.connectivity = nodes.connectivity.data();
+    f.body = nodes.body.data();
+    f.plastic_strain = nodes.plastic_strain.data();
+    f.lattice_plastic_strain = lattice_plastic_strain;
+    f.power = power;
+    return f;
+}
+
+template <int D>
+void apply_hourglass_control(const CompressedRows& lists, const ScatterPlan& plan, const HourglassFields<D>& f,
+                             std::size_t real_count, double coefficient) {
+    const auto load = [](const std::array<const double*, D>& field, std::size_t i) {
+        Vec<D> v;
+        for (int c = 0; c < D; ++c) v[c] = field[c][i];
+        return v;
+    };
+    // The pairs the control acts on: a centre's real neighbours of its own body (ghosts and other
+    // bodies take no part).
+    const auto controlled_pair = [&](std::size_t i, NodeIndex j) { return j < real_count && f.body[j] == f.body[i]; };
+    const auto centre = [&](std::size_t i) {
+        f.power[i] = 0.0;
+        if (i >= real_count) return;
+        if (f.connectivity[i] != Connectivity::Fixed && !(f.plastic_strain[i] < f.lattice_plastic_strain)) return;
+        const Vec<D> x_i = load(f.position, i), v_i = load(f.velocity, i);
+        // Pass 1: the weighted least-squares velocity gradient of the lattice pairs.
+        HourglassFit<D> fit;
+        for (NodeIndex j : lists.row(i)) {
+            if (!controlled_pair(i, j)) continue;
+            const Vec<D> r = load(f.position, j) - x_i;
+            accumulate_hourglass_fit<D>(r, load(f.velocity, j) - v_i, hourglass_pair_weight(f.size_weight[j], r.squaredNorm()), fit);
+        }
+        Mat<D> inverse;
+        bool invertible = false;
+        double determinant = 0.0;
+        fit.moment.computeInverseAndDetWithCheck(inverse, determinant, invertible,
+                                                 1e-12 * std::pow(fit.moment.trace(), D));
+        // A neighbourhood that gives no fit in some direction (a single row or column of nodes)
+        // has no affine reference to damp against: no control there.
+        if (!invertible || !(fit.weight > 0.0)) return;
+        const Mat<D> fitted_gradient = fit.difference * inverse;
+        const double kappa = hourglass_damping(coefficient, f.mass[i], f.sound_speed[i], f.smallest_h[i]) / fit.weight;
+        // Pass 2: F_j = - kappa w_j e_ij on the neighbour, the reaction on the centre.
+        Vec<D> on_centre = Vec<D>::Zero();
+        double power = 0.0;
+        for (NodeIndex j : lists.row(i)) {
+            if (!controlled_pair(i, j)) continue;
+            const Vec<D> r = load(f.position, j) - x_i;
+            const Vec<D> dv = load(f.velocity, j) - v_i;
+            const Vec<D> force_on_j = (-kappa * hourglass_pair_weight(f.size_weight[j], r.squaredNorm())) *
+                                      hourglass_velocity_error<D>(fitted_gradient, r, dv);
+            for (int c = 0; c < D; ++c) f.force[c][j] += force_on_j[c];
+            on_centre -= force_on_j;
+            power += force_on_j.dot(dv);
+        }
+        for (int c = 0; c < D; ++c) f.force[c][i] += on_centre[c];
+        f.power[i] = power;
+    };
+    for (std::size_t colour = 0; colour < plan.colours(); ++colour) {
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(plan.colour_offsets[colour], plan.colour_offsets[colour + 1], 1),
+                          [&](const tbb::blocked_range<std::size_t>& groups) {
+                              for (std::size_t g = groups.begin(); g != groups.end(); ++g) {
+                                  for (NodeIndex i : plan.group(g)) centre(i);
+                              }
+                          });
+    }
+}
+
+template HourglassFields<2> hourglass_fields<2>(NodeStore&, double, double*);
+template HourglassFields<3> hourglass_fields<3>(NodeStore&, double, double*);
+template void apply_hourglass_control<2>(const CompressedRows&, const ScatterPlan&, const HourglassFields<2>&, std::size_t, double);
+template void apply_hourglass_control<3>(const CompressedRows&, const ScatterPlan&, const HourglassFields<3>&, std::size_t, double);
+
+}  // namespace gpa
