@@ -110,6 +110,10 @@ int run_scene(const RunOptions& options) {
     try {
         while (!sim.finished()) {
             sim.step();
+            if (const auto& t = sim.totals(); t.collapse_switches > 0 && !options.quiet) {
+                spdlog::warn("step {}: {} fixed node{} switched to variable connectivity because a lattice cell collapsed; first: {}",
+                             t.step, t.collapse_switches, t.collapse_switches == 1 ? "" : "s", t.first_collapse_switch);
+            }
             const bool last = sim.finished();
             if (last || sim.steps() % std::max<std::size_t>(scene.output.history_every, 1) == 0) history.write(sim.totals());
             if (last || (interval > 0.0 && sim.time() >= next_snapshot * (1.0 - 1e-9))) {

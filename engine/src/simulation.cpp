@@ -17,6 +17,7 @@
 #include "gpa/engine/ghosts.hpp"
 #include "gpa/engine/hourglass.hpp"
 #include "gpa/engine/kernels.hpp"
+#include "gpa/engine/lattice_check.hpp"
 #include "gpa/engine/neighbours.hpp"
 #include "gpa/engine/parallel.hpp"
 #include "gpa/engine/smoothing.hpp"
@@ -90,6 +91,7 @@ struct Simulation::Impl {
     std::vector<double> bond_power;
     bool with_hourglass = false;         // C_hg > 0
     std::vector<double> hourglass_power; // per centre, the power of its hourglass-control forces
+    std::vector<double> cell_ratio;      // per node, its smallest lattice-cell volume ratio (lattice_check.hpp)
     double hourglass_work = 0.0;
     std::vector<double> largest_bond_q;  // per centre, the largest Q_ij of its pairs (for the time step)
     bool failed = false;                 // a phase threw: the state is half-updated
@@ -482,14 +484,41 @@ void Simulation::Impl::stress() {
 }
 
 void Simulation::Impl::switching() {
-    // Paper section 6: a fixed node switches to variable connectivity, for the rest of the run,
-    // once its equivalent plastic strain exceeds the threshold.
+    // Lattice cells first (spec section 2, "[spec] Lattice cells"): a fixed node whose cell has
+    // collapsed or inverted cannot go on with its lattice stencil. In a fixed body the run stops
+    // there; in an automatic body the node switches at once. Then paper section 6: a fixed node of
+    // an automatic body switches to variable connectivity, for the rest of the run, once its
+    // equivalent plastic strain exceeds the threshold. Decisions read the state before any switch.
+    smallest_lattice_cell_ratios(nodes, real, cell_ratio);
     const double threshold = scene.solver.switch_plastic_strain;
+    totals.collapse_switches = 0;
+    totals.first_collapse_switch.clear();
+    const auto where = [&](std::size_t i) {
+        const auto& body = scene.bodies[static_cast<std::size_t>(nodes.body[i])];
+        std::string at = fmt::format("body \"{}\", node {} at ", body.name, i);
+        if (dim() == 2) return at + fmt::format("(x, z) = ({:.4g}, {:.4g}) mm", nodes.position[0][i] * 1e3, nodes.position[1][i] * 1e3);
+        return at + fmt::format("(x, y, z) = ({:.4g}, {:.4g}, {:.4g}) mm", nodes.position[0][i] * 1e3, nodes.position[1][i] * 1e3,
+                                nodes.position[2][i] * 1e3);
+    };
     for (std::size_t i = 0; i < real; ++i) {
-        if (nodes.connectivity[i] == Connectivity::Fixed && body_mode[static_cast<std::size_t>(nodes.body[i])] == ConnectivityMode::Automatic &&
-            nodes.plastic_strain[i] > threshold) {
-            nodes.connectivity[i] = Connectivity::Variable;
-            search_due = true;  // its row must be searched under the variable rule
+        if (nodes.connectivity[i] != Connectivity::Fixed) continue;
+        const bool collapsed = !(cell_ratio[i] > collapsed_cell_ratio);
+        if (body_mode[static_cast<std::size_t>(nodes.body[i])] == ConnectivityMode::Fixed) {
+            if (!collapsed) continue;
+            throw NumericalError(fmt::format(
+                "{}, step {}, t = {:.4g} us: a lattice cell of this fixed-connectivity node has {} (volume ratio {:.3g}); "
+                "a fixed lattice cannot follow this deformation. Give the body connectivity = \"automatic\" (nodes switch "
+                "to variable connectivity as they deform) or \"variable\"; a finer spacing helps only where the lattice "
+                "tangles at a sharp gradient, not under large flow",
+                where(i), steps + 1, time * 1e6, cell_ratio[i] <= 0.0 ? "inverted" : "collapsed", cell_ratio[i]));
+        }
+        if (!collapsed && !(nodes.plastic_strain[i] > threshold)) continue;
+        nodes.connectivity[i] = Connectivity::Variable;
+        search_due = true;  // its row must be searched under the variable rule
+        if (collapsed && !(nodes.plastic_strain[i] > threshold)) {
+            if (totals.collapse_switches++ == 0) {
+                totals.first_collapse_switch = fmt::format("{} (cell volume ratio {:.3g})", where(i), cell_ratio[i]);
+            }
         }
     }
 }
@@ -716,7 +745,8 @@ void Simulation::Impl::build_phase_graph() {
     }
     // Switching last: a node that switches takes its new rule from the next geometry on, so that
     // its strain rates and forces always use one rule (spec section 2).
-    if (std::any_of(body_mode.begin(), body_mode.end(), [](ConnectivityMode m) { return m == ConnectivityMode::Automatic; })) {
+    // (Fixed bodies need it too: it checks their lattice cells.)
+    if (std::any_of(body_mode.begin(), body_mode.end(), [](ConnectivityMode m) { return m != ConnectivityMode::Variable; })) {
         graph->add("switching", [this] { switching(); });
     }
     graph->add("totals", [this] {

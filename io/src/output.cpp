@@ -55,7 +55,7 @@ HistoryWriter::HistoryWriter(const fs::path& file, const Totals& first, int dim)
     if (!file_) throw OutputError(fmt::format("cannot write '{}': {}", file.string(), std::strerror(errno)));
     std::string header =
         "time_s,dt_s,step,kinetic_energy_J,internal_energy_J,plastic_work_J,viscous_work_J,boundary_work_J,"
-        "total_energy_error";
+        "total_energy_error,hourglass_work_J";
     header += dim == 3 ? ",momentum_x_kg_m_s,momentum_y_kg_m_s,momentum_z_kg_m_s" : ",momentum_x_kg_m_s,momentum_z_kg_m_s";
     header += ",length_m,footprint_diameter_m";
     for (const auto& p : first.planes) header += fmt::format(",{0}_reaction_N,{0}_impulse_N_s", p.name.empty() ? "plane" : p.name);
@@ -68,9 +68,9 @@ HistoryWriter::~HistoryWriter() {
 }
 
 void HistoryWriter::write(const Totals& t) {
-    std::string row = fmt::format("{:.9e},{:.6e},{},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.6e}", t.time, t.time_step, t.step,
-                                  t.kinetic_energy, t.internal_energy, t.plastic_work, t.viscous_work, t.boundary_work,
-                                  t.energy_error);
+    std::string row = fmt::format("{:.9e},{:.6e},{},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.6e},{:.9e}", t.time, t.time_step,
+                                  t.step, t.kinetic_energy, t.internal_energy, t.plastic_work, t.viscous_work,
+                                  t.boundary_work, t.energy_error, t.hourglass_work);
     for (int c = 0; c < dim_; ++c) row += fmt::format(",{:.9e}", t.momentum[c]);
     row += fmt::format(",{:.9e},{:.9e}", t.length, t.footprint_diameter);
     for (std::size_t p = 0; p < planes_; ++p) {
@@ -154,9 +154,10 @@ void write_summary(const fs::path& file, const Simulation& sim, const RunSummary
     field("final", fmt::format("{{\"length_m\": {}, \"footprint_diameter_m\": {}, \"plastic_work_J\": {}}}",
                                json_number(t.length), json_number(t.footprint_diameter), json_number(t.plastic_work)));
     field("energy", fmt::format("{{\"initial_J\": {}, \"kinetic_J\": {}, \"internal_J\": {}, \"plastic_work_J\": {}, "
-                                "\"viscous_work_J\": {}, \"boundary_work_J\": {}, \"relative_error\": {}}}",
+                                "\"viscous_work_J\": {}, \"hourglass_work_J\": {}, \"boundary_work_J\": {}, \"relative_error\": {}}}",
                                 json_number(t.initial_energy), json_number(t.kinetic_energy), json_number(t.internal_energy),
-                                json_number(t.plastic_work), json_number(t.viscous_work), json_number(t.boundary_work),
+                                json_number(t.plastic_work), json_number(t.viscous_work), json_number(t.hourglass_work),
+                                json_number(t.boundary_work),
                                 json_number(t.energy_error)));
     std::string planes = "[";
     for (std::size_t p = 0; p < t.planes.size(); ++p) {

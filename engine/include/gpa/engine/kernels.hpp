@@ -173,6 +173,17 @@ inline Vec<D> hourglass_velocity_error(const Mat<D>& fitted_gradient, const Vec<
     return dv - fitted_gradient * r;
 }
 
+// The volume ratio of a lattice cell of a fixed-connectivity node (spec section 2, "[spec] Lattice
+// cells"): the cell spanned by the edges from the node to D of its axis neighbours (one per axis),
+// its signed area (2D) or volume (3D) now over that on the initial lattice. In axisymmetric
+// geometry the cell is a ring, so its area ratio is scaled by x / x0 of the node. The ratio is the
+// cell's J = V / V0: near the node's own V / V0 while the lattice deforms smoothly; at or below 0
+// the cell has inverted, and no solid is crushed to a small fraction of its volume.
+template <int D>
+inline double lattice_cell_ratio(const Mat<D>& current_edges, const Mat<D>& initial_edges) {
+    return current_edges.determinant() / initial_edges.determinant();
+}
+
 // Eq. 3 and its plane-strain and 3D analogues (spec section 2):
 //   axisymmetric d = d0 sqrt((1 + eps_v) x0 / x), plane strain d = d0 sqrt(1 + eps_v),
 //   3D d = d0 (1 + eps_v)^(1/3).

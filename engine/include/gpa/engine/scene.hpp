@@ -101,7 +101,7 @@ struct SolverOptions {
     double bond_viscosity_eps0 = 0.01; // Eq. 38
     // C_hg of the zero-energy-mode control of fixed-connectivity centres (kernels.hpp, spec
     // section 2): 0 = off. It acts only on fixed nodes (fixed and automatic bodies).
-    double hourglass_coefficient = 0.05;
+    double hourglass_coefficient = 0.1;
     SmoothingMode smoothing = SmoothingMode::Off;
     double smoothing_coefficient = 0.1;  // C_cs (Eq. 67)
     // C_cfl of the stable time step (spec section 11). The largest value found stable: 0.6 (the

@@ -11,7 +11,8 @@
 //   dt^{n+3/2} = C_cfl min l / (c + sqrt(Q / rho))        time step
 //   F^{n+1} from sigma^{n+1}                              forces
 //   v^{n+3/2} = v^{n+1/2} + (dt^{n+1/2} + dt^{n+3/2})/2 F / M   integrate, [smoothing]
-//   fixed -> variable above the plastic-strain threshold  [switching]
+//   lattice cells checked; fixed -> variable above the    [switching]
+//     plastic-strain threshold or where a cell collapsed
 //
 // After step() the positions, stresses and energies are those of t^{n+1}; velocities are the
 // half step ahead (v^{n+3/2}), and the kinetic energy reported for t^{n+1} is the mean of the two
@@ -55,6 +56,10 @@ struct Totals {
     double footprint_diameter = 0.0;  // width of the nodes within d of the first rigid plane, m
     std::size_t real_nodes = 0, ghost_nodes = 0, variable_nodes = 0, failed_nodes = 0, pairs = 0;
     std::size_t neighbour_searches = 0;  // full searches so far (the others steps reuse candidate lists)
+    // Fixed nodes of automatic bodies that the last step switched because a lattice cell had
+    // collapsed or inverted (before their plastic strain reached the threshold), and the first of them.
+    std::size_t collapse_switches = 0;
+    std::string first_collapse_switch;
 };
 
 class Simulation {

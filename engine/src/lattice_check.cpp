@@ -1,0 +1,78 @@
+#include "gpa/engine/lattice_check.hpp"
+
+#include <array>
+#include <cmath>
+#include <limits>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <Eigen/LU>
+
+#include "gpa/engine/kernels.hpp"
+
+namespace gpa {
+
+namespace {
+
+template <int D>
+void ratios(const NodeStore& n, std::size_t real_count, bool axisymmetric, std::vector<double>& out) {
+    constexpr double none = std::numeric_limits<double>::infinity();
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, real_count, 1024), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+            out[i] = none;
+            if (n.connectivity[i] != Connectivity::Fixed) continue;
+            // The axis neighbours, found by their initial offsets: [axis][0] below, [axis][1] above.
+            std::array<std::array<std::int64_t, 2>, D> axis;
+            for (auto& a : axis) a = {-1, -1};
+            for (NodeIndex j : n.fixed_neighbours.row(i)) {
+                if (n.connectivity[j] != Connectivity::Fixed) continue;
+                int along = -1, nonzero = 0;
+                for (int c = 0; c < D; ++c) {
+                    if (std::abs(n.initial_position[c][j] - n.initial_position[c][i]) > 1e-3 * n.initial_diameter[i]) {
+                        along = c;
+                        ++nonzero;
+                    }
+                }
+                if (nonzero != 1) continue;
+                axis[along][n.initial_position[along][j] > n.initial_position[along][i] ? 1 : 0] = j;
+            }
+            double smallest = none;
+            // Every choice of one side per axis is a cell (2^D of them).
+            for (int cell = 0; cell < (1 << D); ++cell) {
+                Mat<D> now, then;
+                bool complete = true;
+                for (int a = 0; a < D && complete; ++a) {
+                    const std::int64_t j = axis[a][(cell >> a) & 1];
+                    if (j < 0) {
+                        complete = false;
+                        break;
+                    }
+                    for (int c = 0; c < D; ++c) {
+                        now(c, a) = n.position[c][static_cast<std::size_t>(j)] - n.position[c][i];
+                        then(c, a) = n.initial_position[c][static_cast<std::size_t>(j)] - n.initial_position[c][i];
+                    }
+                }
+                if (!complete) continue;
+                double ratio = lattice_cell_ratio<D>(now, then);
+                if (axisymmetric) ratio *= n.position[0][i] / n.initial_position[0][i];
+                // NaN (a non-finite position) counts as collapsed.
+                if (!(ratio >= smallest)) smallest = std::isnan(ratio) ? -none : ratio;
+            }
+            out[i] = smallest;
+        }
+    });
+}
+
+}  // namespace
+
+void smallest_lattice_cell_ratios(const NodeStore& nodes, std::size_t real_count, std::vector<double>& out) {
+    out.resize(real_count);
+    if (nodes.dim() == 3) {
+        ratios<3>(nodes, real_count, false, out);
+    } else {
+        ratios<2>(nodes, real_count, nodes.geometry() == GeometryKind::Axisymmetric, out);
+    }
+}
+
+}  // namespace gpa
