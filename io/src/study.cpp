@@ -425,6 +425,8 @@ const std::vector<MetricInfo>& study_metrics() {
         {"rebound_speed", "m/s", "m/s", 1.0, true, "|momentum along the plane normal| / mass after lift-off"},
         {"plastic_work", "J", "J", 1.0, true, "plastic work at the end"},
         {"energy_error", "", "%", 100.0, false, "(KE + IE + boundary work - E0) / E0 at the end"},
+        {"variable_fraction", "", "%", 100.0, false, "share of the real nodes with variable connectivity at the end"},
+        {"hourglass_work", "J", "J", 1.0, false, "work of the hourglass control of lattice-regime nodes at the end"},
     };
     return metrics;
 }
@@ -466,7 +468,10 @@ void RunProbe::observe(const Simulation& sim) {
 
 std::map<std::string, double> RunProbe::metrics(const Simulation& sim) const {
     const auto& t = sim.totals();
-    std::map<std::string, double> m{{"plastic_work", t.plastic_work}, {"energy_error", t.energy_error}};
+    std::map<std::string, double> m{{"plastic_work", t.plastic_work},
+                                    {"energy_error", t.energy_error},
+                                    {"variable_fraction", static_cast<double>(t.variable_nodes) / static_cast<double>(t.real_nodes)},
+                                    {"hourglass_work", t.hourglass_work}};
     if (plane_ < 0) return m;
     const bool left = lift_off_ && contact_start_ >= 0.0 && !touching_ && contact_end_ >= 0.0;
     if (left) {

@@ -129,11 +129,12 @@ inline double advance_volumetric_strain(double eps_v, double rate, double dt) {
     return eps_v + rate * dt * (1.0 + eps_v);
 }
 
-// Zero-energy-mode control of fixed-connectivity centres (spec section 2, "[spec] Hourglass
-// control"). With R = 1 on a lattice stencil, a velocity field that alternates from row to row
-// (v_j equal for the neighbours on both sides of i) gives sum_j W (v_j - v_i) l_b / r = 0 in
-// Eq. 7-8: no strain rate, no stress, no restoring force. The control measures, for each lattice
-// pair, how far the velocity difference departs from the best affine fit around the centre,
+// Zero-energy-mode (hourglass) control of the nodes in the lattice regime (spec section 2,
+// "[spec] Hourglass control"; docs/connectivity.md). On a lattice stencil a velocity field that
+// alternates from row to row (v_j equal for the neighbours on both sides of i) gives
+// sum_j R W (v_j - v_i) l_b / r = 0 in Eq. 7-8: no strain rate, no stress, no restoring force.
+// The control measures, for each pair, how far the velocity difference departs from the best
+// affine fit around the centre,
 //   e_ij = (v_j - v_i) - Lfit_i (x_j - x_i),   Lfit_i = [sum_j w_j dv_j r_j^T] [sum_j w_j r_j r_j^T]^-1,
 // with w_j = W_j / r_ij^2, and damps it with equal and opposite pair forces
 //   F_j = - kappa_i w_j e_ij / sum_k w_k,   F_i = - sum_j F_j,   kappa_i = C_hg M_i c_i / h_i.

@@ -139,7 +139,7 @@ struct MetricInfo {
 };
 
 // Every metric a study may report, in table order: final_length, footprint_diameter,
-// contact_time, rebound_speed, plastic_work, energy_error.
+// contact_time, rebound_speed, plastic_work, energy_error, variable_fraction, hourglass_work.
 const std::vector<MetricInfo>& study_metrics();
 const MetricInfo* find_study_metric(std::string_view key);
 
@@ -150,7 +150,8 @@ const MetricInfo* find_study_metric(std::string_view key);
 //     it and then left it for good: the time from the onset of contact to its end (each placed
 //     half way between the last step on one side and the first on the other) and
 //     |momentum along the plane normal| / total mass at the end of the run;
-//   plastic_work (J), energy_error (relative): from the final totals.
+//   plastic_work (J), energy_error (relative), variable_fraction (share of the real nodes with
+//     variable connectivity), hourglass_work (J): from the final totals.
 // A metric that does not apply is absent from the map.
 class RunProbe {
 public:
