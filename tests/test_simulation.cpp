@@ -172,7 +172,7 @@ TEST(NeighbourSkin, CutCandidatesEqualAFullSearchEveryStep) {
     cases.push_back({"axisymmetric Taylor bar, variable", testing::armco_cylinder(6, 40e-6), 300});
     {
         auto scene = testing::armco_cylinder(6, 40e-6);
-        scene.solver.connectivity = ConnectivityMode::Automatic;  // switching forces searches
+        scene.solver.connectivity = ConnectivityMode::Automatic;  // nodes switch between searches
         scene.solver.switch_plastic_strain = 0.05;
         cases.push_back({"axisymmetric Taylor bar, automatic switching", scene, 300});
     }

@@ -137,7 +137,7 @@ void GhostSet::build(NodeStore& nodes, std::size_t real_count, double range, boo
         for (std::size_t k = nodes.fixed_mirrors.offsets[i]; k < nodes.fixed_mirrors.offsets[i + 1]; ++k) {
             const std::uint8_t m = nodes.fixed_mirror_planes[k];
             const NodeIndex j = nodes.fixed_mirrors.indices[k];
-            if (!selectable(nodes, i, m) || !selectable(nodes, j, m) || nodes.connectivity[j] != Connectivity::Fixed) continue;
+            if (!selectable(nodes, i, m) || !selectable(nodes, j, m)) continue;
             const std::size_t slot = mask_slot(m);
             needed[slot][j] = 1;
             needed[slot][i] = 1;
@@ -305,7 +305,6 @@ const CompressedRows& GhostSet::resolved_fixed_mirrors(const NodeStore& nodes, s
             const std::uint8_t m = nodes.fixed_mirror_planes[k];
             const NodeIndex j = nodes.fixed_mirrors.indices[k];
             if (!selectable(nodes, i, m) || !selectable(nodes, j, m)) continue;  // not touching a lift-off plane
-            if (nodes.connectivity[j] != Connectivity::Fixed) continue;  // a switched source's ghost is found by search
             const std::int64_t g = index_[mask_slot(m)][j];
             if (g < 0) throw NumericalError(fmt::format("node {}: its mirrored lattice neighbour has no ghost", i));
             resolved_.indices.push_back(static_cast<NodeIndex>(g));

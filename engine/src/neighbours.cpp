@@ -107,7 +107,7 @@ bool needs_search(const NodeStore& nodes, std::size_t centres) {
 }
 
 void find_neighbours(const NodeStore& nodes, double a, std::size_t centres, CompressedRows& out,
-                     NeighbourScratch& scratch, const CompressedRows* extra_fixed, double skin) {
+                     NeighbourScratch& scratch, const CompressedRows* extra_fixed, double skin, bool fixed_may_switch) {
     check_influence_distance(a);
     if (!(skin >= 0.0) || !std::isfinite(skin)) throw InputError(fmt::format("find_neighbours: skin {} must be a finite length >= 0", skin));
     const std::size_t n = nodes.size();
@@ -119,7 +119,9 @@ void find_neighbours(const NodeStore& nodes, double a, std::size_t centres, Comp
     if (extra_fixed && extra_fixed->rows() < centres) {
         throw InputError(fmt::format("find_neighbours: extra fixed lists cover {} of {} centres", extra_fixed->rows(), centres));
     }
-    const bool search = needs_search(nodes, centres);
+    // Candidates that outlive switching (see the header): needed only where fixed nodes may switch.
+    const bool candidates = skin > 0.0 && fixed_may_switch;
+    const bool search = needs_search(nodes, centres) || candidates;
     // Cells of half the reach, and the 5 (or 5 x 5 x 5) cells around a centre's: the cells cover
     // 2.5 reaches across instead of 3, which spares about a third of the distance checks in 2D
     // and half in 3D. (The grid may enlarge its cells to bound their number; the span follows.)
@@ -130,17 +132,30 @@ void find_neighbours(const NodeStore& nodes, double a, std::size_t centres, Comp
     // A neighbour is less than `reach` away along each axis, so at most ceil(reach / edge) cells.
     const std::size_t span = search && grid.cell_size > 0.0 ? static_cast<std::size_t>(std::ceil(reach / grid.cell_size)) : 1;
 
+    // Lattice pairs link two fixed nodes; a lattice neighbour that has switched is a variable pair
+    // now, found by the search like any other node (spec section 2, mixed pairs).
+    const auto lattice_neighbour = [&](std::size_t i, NodeIndex j) {
+        for (NodeIndex k : nodes.fixed_neighbours.row(i)) {
+            if (k == j) return true;
+        }
+        if (extra_fixed) {
+            for (NodeIndex k : extra_fixed->row(i)) {
+                if (k == j) return true;
+            }
+        }
+        return false;
+    };
     // Calls emit(j) for every neighbour j of centre i, in the order described in the header.
     const auto visit = [&](std::size_t i, auto&& emit) {
         const bool fixed = nodes.connectivity[i] == Connectivity::Fixed;
         if (fixed) {
-            // Lattice pairs link two fixed nodes; a lattice neighbour that has switched is a
-            // variable pair now, found below like any other (spec section 2, mixed pairs).
             for (NodeIndex j : nodes.fixed_neighbours.row(i)) {
-                if (nodes.connectivity[j] == Connectivity::Fixed) emit(j);
+                if (candidates || nodes.connectivity[j] == Connectivity::Fixed) emit(j);
             }
             if (extra_fixed) {
-                for (NodeIndex j : extra_fixed->row(i)) emit(j);
+                for (NodeIndex j : extra_fixed->row(i)) {
+                    if (candidates || nodes.connectivity[j] == Connectivity::Fixed) emit(j);  // a ghost has its source's mode
+                }
             }
         }
         if (!search) return;
@@ -158,7 +173,12 @@ void find_neighbours(const NodeStore& nodes, double a, std::size_t centres, Comp
                     const std::size_t cell = grid.linear(c);
                     for (std::size_t k = grid.cell_start[cell]; k < grid.cell_start[cell + 1]; ++k) {
                         const NodeIndex j = grid.nodes[k];
-                        if (j == i || (fixed && nodes.body[j] == own_body && nodes.connectivity[j] == Connectivity::Fixed)) continue;
+                        if (j == i) continue;
+                        if (fixed && nodes.body[j] == own_body) {
+                            // A lattice neighbour is in the row already; another fixed node of the
+                            // body is no pair of a fixed centre, but may become one when either switches.
+                            if (candidates ? lattice_neighbour(i, j) : nodes.connectivity[j] == Connectivity::Fixed) continue;
+                        }
                         if (skin > 0.0 ? is_candidate(nodes, a, skin, i, j) : is_pair(nodes, a, i, j)) emit(j);
                     }
                 }
@@ -198,31 +218,44 @@ namespace {
 
 template <int D>
 void filter_rows(const NodeStore& nodes, double a, const CompressedRows& candidates,
-                 const std::vector<std::uint32_t>& unconditional, CompressedRows& out, std::vector<std::uint8_t>& keep) {
+                 const std::vector<std::uint32_t>& lattice_entries, CompressedRows& out, std::vector<std::uint8_t>& keep) {
     const std::size_t rows = candidates.rows();
     std::array<const double*, D> x{};
     for (int c = 0; c < D; ++c) x[c] = nodes.position[c].data();
     const double* d = nodes.diameter.data();
     const NodeIndex* index = candidates.indices.data();
     // Pass 1: mark the kept entries and count them per row (the counts go to offsets[i + 1]).
+    // The rule of spec section 2 as it stands now (nodes may have switched since the search): a
+    // lattice entry is kept while both its nodes are fixed, and otherwise like any other entry,
+    // when r_ij < 2 h_ij and it is not a pair of two fixed nodes of one body.
+    const Connectivity* mode = nodes.connectivity.data();
+    const std::int32_t* body = nodes.body.data();
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rows, search_block), [&](const tbb::blocked_range<std::size_t>& r) {
         for (std::size_t i = r.begin(); i != r.end(); ++i) {
             const std::size_t first = candidates.offsets[i], last = candidates.offsets[i + 1];
-            const std::size_t fixed_end = std::min(last, first + unconditional[i]);
-            std::size_t kept = fixed_end - first;
-            for (std::size_t e = first; e < fixed_end; ++e) keep[e] = 1;
+            const std::size_t lattice_end = std::min(last, first + lattice_entries[i]);
+            const bool fixed_centre = mode[i] == Connectivity::Fixed;
             std::array<double, D> xi;
             for (int c = 0; c < D; ++c) xi[c] = x[c][i];
             const double di = d[i];
-            for (std::size_t e = fixed_end; e < last; ++e) {
+            std::size_t kept = 0;
+            for (std::size_t e = first; e < last; ++e) {
                 const NodeIndex j = index[e];
-                double r2 = 0.0;
-                for (int c = 0; c < D; ++c) {
-                    const double dx = x[c][j] - xi[c];
-                    r2 += dx * dx;
+                const bool both_fixed = fixed_centre && mode[j] == Connectivity::Fixed;
+                bool pair;
+                if (e < lattice_end && both_fixed) {
+                    pair = true;
+                } else if (both_fixed && body[j] == body[i]) {
+                    pair = false;
+                } else {
+                    double r2 = 0.0;
+                    for (int c = 0; c < D; ++c) {
+                        const double dx = x[c][j] - xi[c];
+                        r2 += dx * dx;
+                    }
+                    // The search's rule, within_influence(r^2, h_ij) (weights.hpp).
+                    pair = within_influence(r2, pair_smoothing_length(a, di, d[j]));
                 }
-                // The search's rule, within_influence(r^2, h_ij) (weights.hpp).
-                const bool pair = within_influence(r2, pair_smoothing_length(a, di, d[j]));
                 keep[e] = pair;
                 kept += pair;
             }
@@ -245,19 +278,19 @@ void filter_rows(const NodeStore& nodes, double a, const CompressedRows& candida
 }  // namespace
 
 void filter_candidates(const NodeStore& nodes, double a, const CompressedRows& candidates,
-                       const std::vector<std::uint32_t>& unconditional, CompressedRows& out,
+                       const std::vector<std::uint32_t>& lattice_entries, CompressedRows& out,
                        std::vector<std::uint8_t>& keep) {
     const std::size_t rows = candidates.rows();
-    if (unconditional.size() < rows) {
-        throw InputError(fmt::format("filter_candidates: {} unconditional counts for {} rows", unconditional.size(), rows));
+    if (lattice_entries.size() < rows) {
+        throw InputError(fmt::format("filter_candidates: {} lattice counts for {} rows", lattice_entries.size(), rows));
     }
     keep.resize(candidates.entries());
     resize_with_slack(out.offsets, rows + 1);
     out.offsets[0] = 0;
     if (nodes.dim() == 2) {
-        filter_rows<2>(nodes, a, candidates, unconditional, out, keep);
+        filter_rows<2>(nodes, a, candidates, lattice_entries, out, keep);
     } else {
-        filter_rows<3>(nodes, a, candidates, unconditional, out, keep);
+        filter_rows<3>(nodes, a, candidates, lattice_entries, out, keep);
     }
 }
 

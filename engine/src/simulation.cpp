@@ -82,7 +82,7 @@ struct Simulation::Impl {
     double skin = 0.0;
     std::size_t searches = 0;
     CompressedRows candidates;
-    std::vector<std::uint32_t> unconditional;
+    std::vector<std::uint32_t> lattice_entries;  // per row: how many leading candidates are lattice neighbours
     std::vector<std::uint8_t> keep_scratch;
     std::array<std::vector<double>, 3> searched_position;
     std::vector<double> searched_diameter;
@@ -90,6 +90,7 @@ struct Simulation::Impl {
     SmoothingScratch smoothing_scratch;
     std::vector<double> bond_power;
     bool with_hourglass = false;         // C_hg > 0
+    bool any_automatic = false;          // some body switches fixed nodes to variable
     std::vector<double> hourglass_power; // per centre, the power of its hourglass-control forces
     std::vector<double> cell_ratio;      // per node, its smallest lattice-cell volume ratio (lattice_check.hpp)
     double hourglass_work = 0.0;
@@ -218,6 +219,7 @@ void Simulation::Impl::setup() {
                                   [](ConnectivityMode m) { return m == ConnectivityMode::Automatic; });
     with_skin = scene.solver.neighbour_skin > 0.0 && !lists_constant;
     with_hourglass = scene.solver.hourglass_coefficient > 0.0;
+    any_automatic = std::any_of(body_mode.begin(), body_mode.end(), [](ConnectivityMode m) { return m == ConnectivityMode::Automatic; });
 
     // Geometry, neighbours, geometry factors and forces at t = 0; then the first half step.
     geometry<G>();
@@ -416,13 +418,11 @@ void Simulation::Impl::check_lists_against_search() {
 void Simulation::Impl::search_candidates() {
     const CompressedRows* mirrored = ghosts.empty() ? nullptr : &ghosts.resolved_fixed_mirrors(nodes, real);
     if (ghosts.empty()) skin = scene.solver.neighbour_skin * largest_interaction_radius(nodes, a(), real);
-    find_neighbours(nodes, a(), real, candidates, search_scratch, mirrored, skin);
-    unconditional.assign(real, 0);
+    find_neighbours(nodes, a(), real, candidates, search_scratch, mirrored, skin, any_automatic);
+    lattice_entries.assign(real, 0);
     for (std::size_t i = 0; i < real; ++i) {
         if (nodes.connectivity[i] != Connectivity::Fixed) continue;
-        std::uint32_t lattice = 0;
-        for (NodeIndex j : nodes.fixed_neighbours.row(i)) lattice += nodes.connectivity[j] == Connectivity::Fixed;
-        unconditional[i] = lattice + static_cast<std::uint32_t>(mirrored ? mirrored->row(i).size() : 0);
+        lattice_entries[i] = static_cast<std::uint32_t>(nodes.fixed_neighbours.row(i).size() + (mirrored ? mirrored->row(i).size() : 0));
     }
     for (int c = 0; c < dim(); ++c) searched_position[c].assign(nodes.position[c].begin(), nodes.position[c].begin() + real);
     searched_diameter.assign(nodes.diameter.begin(), nodes.diameter.begin() + real);
@@ -446,7 +446,7 @@ void Simulation::Impl::neighbours() {
     if (lists_constant && lists.rows() == real) return;
     if (with_skin) {
         if (search_due) search_candidates();
-        filter_candidates(nodes, a(), candidates, unconditional, lists, keep_scratch);
+        filter_candidates(nodes, a(), candidates, lattice_entries, lists, keep_scratch);
         if (!ghosts.empty()) ghosts.remove_pairs_without_contact(lists, nodes, real);
         if (scene.solver.check_neighbour_lists) check_lists_against_search();
         if (!ghosts.empty()) ghosts.append_ghost_rows(lists, real);
@@ -513,8 +513,9 @@ void Simulation::Impl::switching() {
                 where(i), steps + 1, time * 1e6, cell_ratio[i] <= 0.0 ? "inverted" : "collapsed", cell_ratio[i]));
         }
         if (!collapsed && !(nodes.plastic_strain[i] > threshold)) continue;
+        // The candidate lists hold every node within reach of a fixed centre too, so they stay
+        // valid: the next cut applies the variable rule to the switched node's pairs.
         nodes.connectivity[i] = Connectivity::Variable;
-        search_due = true;  // its row must be searched under the variable rule
         if (collapsed && !(nodes.plastic_strain[i] > threshold)) {
             if (totals.collapse_switches++ == 0) {
                 totals.first_collapse_switch = fmt::format("{} (cell volume ratio {:.3g})", where(i), cell_ratio[i]);

@@ -44,23 +44,29 @@ struct NeighbourScratch {
 
 // The neighbour lists of centres [0, centres), drawn from all nodes [0, nodes.size()):
 //   a variable centre: every j != i with r_ij < 2 h_ij;
-//   a fixed centre: its lattice neighbours, then its rows of `extra_fixed` (if given: the ghost
-//   images of lattice neighbours across planes), then every node of another body with
-//   r_ij < 2 h_ij.
+//   a fixed centre: its lattice neighbours that are fixed, then those of its rows of `extra_fixed`
+//   (if given: the ghost images of lattice neighbours across planes), then every variable node of
+//   its body and every node of another body with r_ij < 2 h_ij (spec section 2: a lattice pair
+//   links two fixed nodes; every other pair is a variable pair).
 // Deterministic and independent of the thread count. Validates a (0.8-1.5).
-// With skin > 0 (a length) the searched part of each row holds candidates instead: every j with
-// r_ij < 2 h_ij + skin. filter_candidates() then cuts them to the pairs of the moment; they stay
-// a superset of the pairs until some pair has closed by more than the skin (Verlet lists).
+// With skin > 0 (a length) the rows hold candidates instead: every j with r_ij < 2 h_ij + skin
+// that the rule could make a pair before the next search. filter_candidates() then cuts them to
+// the pairs of the moment; they stay a superset of the pairs until some pair has closed by more
+// than the skin (Verlet lists). With fixed_may_switch (automatic bodies), the candidates also
+// outlive switching: a fixed centre's row holds all its lattice neighbours and mirrors, of either
+// mode, then every other node within reach, fixed nodes of its body included.
 void find_neighbours(const NodeStore& nodes, double influence_distance, std::size_t centres,
                      CompressedRows& out, NeighbourScratch& scratch,
-                     const CompressedRows* extra_fixed = nullptr, double skin = 0.0);
+                     const CompressedRows* extra_fixed = nullptr, double skin = 0.0, bool fixed_may_switch = false);
 CompressedRows find_neighbours(const NodeStore& nodes, double influence_distance, std::size_t centres);
 
-// The pairs of the moment from candidate lists: of row i, the first unconditional[i] entries (a
-// fixed centre's lattice neighbours and their mirrors) and every other j with r_ij < 2 h_ij, in
-// the candidates' order. Deterministic and independent of the thread count.
+// The pairs of the moment from candidate lists, in the candidates' order: of row i, the first
+// lattice_entries[i] entries (a fixed centre's lattice neighbours and their mirrors, of either
+// mode) while both nodes are fixed, and every j with r_ij < 2 h_ij that is not a pair of two fixed
+// nodes of one body (spec section 2). Nodes may switch between the search and the cut.
+// Deterministic and independent of the thread count.
 void filter_candidates(const NodeStore& nodes, double influence_distance, const CompressedRows& candidates,
-                       const std::vector<std::uint32_t>& unconditional, CompressedRows& out,
+                       const std::vector<std::uint32_t>& lattice_entries, CompressedRows& out,
                        std::vector<std::uint8_t>& keep);
 
 // The same lists from an all-pairs loop: the check for find_neighbours. O(n^2).
