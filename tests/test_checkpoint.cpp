@@ -81,22 +81,23 @@ struct Case {
     Scene scene;
     int stop_at;  // the step of the checkpoint
     int steps;    // the steps of the whole run
+    bool both_ways = false;  // stopped on 1 thread and resumed on 2, and the other way round; else 1 -> 2
 };
 
 std::vector<Case> cases() {
     std::vector<Case> out;
     {
-        // About 6000 nodes: every parallel loop and reduction is split over several ranges.
+        // About 4800 nodes: every parallel loop and reduction is split over several ranges.
         auto scene = testing::armco_cylinder(40, 40e-6);
-        scene.solver.reorder_interval = 50;  // a reordering after the checkpoint
-        out.push_back({"axisymmetric Taylor bar, variable, skin, reordering", scene, 73, 140});
+        scene.solver.reorder_interval = 30;  // reorderings before and after the checkpoint
+        out.push_back({"axisymmetric Taylor bar, variable, skin, reordering", scene, 47, 80, true});
     }
     {
         auto scene = testing::armco_cylinder(12, 40e-6);
         scene.solver.connectivity = ConnectivityMode::Automatic;  // switching: searches forced mid-skin
         scene.solver.switch_plastic_strain = 0.05;
         scene.solver.smoothing = SmoothingMode::Everywhere;
-        out.push_back({"automatic switching with smoothing", scene, 131, 260});
+        out.push_back({"automatic switching with smoothing", scene, 131, 220});
     }
     {
         auto scene = testing::elastic_bar_on_plane(1e-3, 12e-3, 8, 100.0);  // lift-off contacts come and go
@@ -104,13 +105,13 @@ std::vector<Case> cases() {
         scene.solver.smoothing = SmoothingMode::Tension;
         scene.stop = {};
         scene.stop.max_steps = 100000;
-        out.push_back({"elastic bar on a lift-off plane, bond viscosity", scene, 211, 420});
+        out.push_back({"elastic bar on a lift-off plane, bond viscosity", scene, 211, 360});
     }
     {
         auto scene = three_d_quarter_bar(4);
         scene.solver.connectivity = ConnectivityMode::Automatic;
         scene.solver.switch_plastic_strain = 0.05;
-        out.push_back({"3D quarter bar on symmetry planes, automatic", scene, 47, 100});
+        out.push_back({"3D quarter bar on symmetry planes, automatic", scene, 47, 90});
     }
     {
         auto scene = testing::armco_cylinder(10, 40e-6);
@@ -124,7 +125,9 @@ std::vector<Case> cases() {
 TEST(Checkpoint, AResumedRunIsBitIdenticalToOneNeverStoppedOnOneAndTwoThreads) {
     for (auto& c : cases()) {
         SCOPED_TRACE(c.name);
-        for (const auto& [first, second] : {std::pair{1, 2}, std::pair{2, 1}}) {
+        std::vector<std::pair<int, int>> threads{{1, 2}};
+        if (c.both_ways) threads.push_back({2, 1});
+        for (const auto& [first, second] : threads) {
             SCOPED_TRACE(::testing::Message() << "stopped on " << first << " thread(s), resumed on " << second);
             Simulation never_stopped(c.scene, first);
             Simulation stopped(c.scene, first);
