@@ -12,10 +12,11 @@ jobs=$(nproc)
 
 # -O1 and line tables only: the quickest build that still gives stack traces with lines.
 flags="-fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer -fsanitize=fuzzer-no-link"
+mkdir -p "$build"
 cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_FLAGS_RELEASE="-O1 -gline-tables-only" \
   -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ \
   -DCMAKE_CXX_FLAGS="$flags" -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined" \
-  -DGPA_BUILD_BENCHMARKS=OFF -DGPA_BUILD_FUZZERS=ON > "$build.configure.log" || { cat "$build.configure.log"; exit 1; }
+  -DGPA_BUILD_BENCHMARKS=OFF -DGPA_BUILD_FUZZERS=ON > "$build/configure.log" || { cat "$build/configure.log"; exit 1; }
 cmake --build "$build" -j"$jobs"
 
 # Reports inside third-party headers only, each explained in the file.
