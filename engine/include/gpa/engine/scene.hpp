@@ -131,7 +131,7 @@ struct StopCriteria {
     std::size_t max_steps = 0;             // 0 = no limit
     // The energy guard: a run whose energy error |KE + IE + boundary work - E0| / E0 exceeds this
     // stops as a numerical failure (an unstable run). The scenes of scenes/ end at 0.1-0.6 % at
-    // the default C_cfl (docs/cfl-range.md), a sphere through a plate at 1.8 %. 0 = no guard.
+    // the default C_cfl (docs/cfl-range.md); a sphere through a plate was reported at 1.8 % (issue 14). 0 = no guard.
     double energy_error = 0.03;
 };
 
