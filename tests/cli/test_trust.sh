@@ -85,8 +85,8 @@ grep -q '"status": "finished"' far/summary.json 2> /dev/null || fail "far body: 
 [[ $(wc -l < far/profile.csv) -gt 2 ]] || fail "far body: profile.csv has no rows"
 
 # --- one run per output folder ---------------------------------------------------------------
-# (8000 steps of 15 ns, a snapshot every 10 us: a few seconds in a release build.)
-variant long.toml -e 's/^max_steps = 20/max_steps = 8000/' -e 's/^snapshots = 3/snapshot_interval = "10 us"/'
+# (4000 steps of 15 ns, a snapshot every 5 us: a quarter of a second in a release build.)
+variant long.toml -e 's/^max_steps = 20/max_steps = 4000/' -e 's/^snapshots = 3/snapshot_interval = "5 us"/'
 "$gpa" run long.toml -o conc -q --threads 1 > conc-first.out 2> conc-first.err &
 first=$!
 wait_for_lines conc.partial/history.csv 20 || fail "the first run never started"
@@ -94,7 +94,7 @@ expect 2 "second run on one folder" -- timeout 10 "$gpa" run long.toml -o conc -
 says err.txt "in use by another gpa run (process $first" "second run"
 wait $first; code=$?
 [[ $code -eq 0 ]] || fail "the first run ended with $code: $(cat conc-first.err)"
-tail -1 conc/history.csv | cut -d, -f3 | grep -qx 8000 || fail "the first run's history does not end with its own last row"
+tail -1 conc/history.csv | cut -d, -f3 | grep -qx 4000 || fail "the first run's history does not end with its own last row"
 grep -q '"status": "finished"' conc/summary.json || fail "the first run's summary"
 [[ -e conc.lock || -e conc.partial ]] && fail "the first run left conc.lock or conc.partial"
 
@@ -146,7 +146,7 @@ interrupt_and_resume INT 2 1 130
 interrupt_and_resume TERM 1 2 143
 
 # A run killed outright (kill -9) resumes from its last periodic checkpoint.
-variant every.toml -e 's/^max_steps = 20/max_steps = 8000/' -e 's/^snapshots = 3/snapshot_interval = "10 us"\ncheckpoint_every = 1000/'
+variant every.toml -e 's/^max_steps = 20/max_steps = 4000/' -e 's/^snapshots = 3/snapshot_interval = "5 us"\ncheckpoint_every = 1000/'
 expect 0 "reference with checkpoints" -- "$gpa" run every.toml -o every-whole -q --threads 2
 cmp -s whole/particles_00010.vtp every-whole/particles_00010.vtp && cmp -s whole/history.csv every-whole/history.csv || fail "writing checkpoints changed a run's results"
 "$gpa" run every.toml -o killed -q --threads 2 > /dev/null 2>&1 &
@@ -174,8 +174,8 @@ expect 0 "resume with its own scene named" -- "$gpa" run --resume other long.tom
 if [[ $(id -u) -eq 0 ]] && mkdir -p small && mount -t tmpfs -o size=1m tmpfs small 2> /dev/null; then
   trap 'umount "$work/small" 2> /dev/null; umount "$work/tiny-disk" 2> /dev/null' EXIT
   # The run fits when it starts; then the disk fills under it.
-  # (20000 steps of 15 ns: 7 snapshots of 15 kB, 200 history rows, a small checkpoint.)
-  variant disk.toml -e 's/^max_steps = 20/max_steps = 20000/' -e 's/^snapshots = 3/snapshot_interval = "50 us"\nhistory_every = 100/'
+  # (8000 steps of 15 ns: 7 snapshots of 15 kB, 80 history rows, a small checkpoint.)
+  variant disk.toml -e 's/^max_steps = 20/max_steps = 8000/' -e 's/^snapshots = 3/snapshot_interval = "20 us"\nhistory_every = 100/'
   "$gpa" run disk.toml -o small/run -q --threads 1 > disk.out 2> disk.err &
   pid=$!
   wait_for_lines small/run.partial/history.csv 5 || fail "disk: the run never started"
