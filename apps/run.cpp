@@ -1,22 +1,31 @@
 #include "run.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <csignal>
 #include <ctime>
 #include <exception>
 #include <future>
+#include <limits>
+#include <sstream>
 #include <string_view>
+#include <system_error>
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
+#include <sys/statvfs.h>
 
 #include "gpa/engine/bodies.hpp"
 #include "gpa/engine/errors.hpp"
 #include "gpa/engine/simulation.hpp"
+#include "gpa/engine/state_io.hpp"
+#include "gpa/io/checkpoint.hpp"
 #include "gpa/io/material_library.hpp"
 #include "gpa/io/output.hpp"
 #include "gpa/io/scene_file.hpp"
 #include "progress.hpp"
+#include "signals.hpp"
 
 namespace gpa::app {
 
@@ -26,20 +35,62 @@ namespace {
 
 namespace fs = std::filesystem;
 
-Scene read_scene(const std::optional<fs::path>& file) {
-    if (file) return io::load_scene(*file);
-    return io::parse_scene(default_scene_text(), "built-in default scene (scenes/armco-cylinder-nodal.toml)");
+constexpr const char* checkpoint_name = "checkpoint.gpack";
+constexpr const char* scene_copy_name = "scene.toml";
+
+// The scene's text and what messages call it.
+struct SceneSource {
+    std::string text;
+    std::string name;   // for messages ("scenes/x.toml")
+    std::string label;  // for the summary's scene_file
+};
+
+SceneSource read_source(const std::optional<fs::path>& file) {
+    if (file) return {io::read_scene_text(*file), file->string(), file->string()};
+    return {std::string(default_scene_text()), "built-in default scene (scenes/armco-cylinder-nodal.toml)",
+            "(built-in default)"};
 }
 
-// Snapshot times: every interval, or `count` spread over the end time; with neither known,
-// the first and the last.
-double snapshot_interval(const Scene& s) {
-    if (s.output.snapshot_interval > 0.0) return s.output.snapshot_interval;
-    if (s.output.snapshots > 1 && s.stop.end_time > 0.0) return s.stop.end_time / double(s.output.snapshots - 1);
-    return 0.0;
-}
+// Scheduled snapshot times: t_k = k * interval for whole k, from `snapshot_interval`, or from
+// `snapshots` spread over the end time; with neither known, the first and the last only. A step
+// writes one when it passes a t_k; which t_k it has reached is computed from its time (a whole
+// number, floor(t / interval)), never by adding the interval up, so that an interval below the
+// rounding step of the time cannot stall the schedule (at most one snapshot per step).
+class SnapshotSchedule {
+public:
+    explicit SnapshotSchedule(const Scene& s) {
+        if (s.output.snapshot_interval > 0.0) {
+            interval_ = s.output.snapshot_interval;
+        } else if (s.output.snapshots > 1 && s.stop.end_time > 0.0) {
+            interval_ = s.stop.end_time / double(s.output.snapshots - 1);
+        }
+    }
+    double interval() const { return interval_; }
+    // The last t_k at or before t (with a relative 1e-9 for a step that lands on t_k).
+    double slot(double t) const { return interval_ > 0.0 ? std::floor(t / interval_ * (1.0 + 1e-9)) : 0.0; }
+    // True (and remembered) when t has passed a scheduled time since the last snapshot.
+    bool due(double t) {
+        if (!(interval_ > 0.0)) return false;
+        const double k = slot(t);
+        if (!(k > last_)) return false;
+        last_ = k;
+        return true;
+    }
+    double last_slot() const { return last_; }
+    void set_last_slot(double k) { last_ = k; }
+    // How many scheduled snapshots [0, end] holds (without a known end: 2).
+    double planned(double end) const {
+        if (!(interval_ > 0.0) || !(end > 0.0) || !std::isfinite(end)) return 2.0;
+        return std::floor(end / interval_ * (1.0 + 1e-9)) + 1.0;
+    }
 
-// A copy of the real nodes, written by a background task while the run goes on.
+private:
+    double interval_ = 0.0;
+    double last_ = 0.0;
+};
+
+// A copy of the real nodes, written by a background task while the run goes on. A write that
+// failed is reported by the next call (write, write_marked or wait).
 class SnapshotWriter {
 public:
     explicit SnapshotWriter(fs::path folder) : series_(std::move(folder)) {}
@@ -60,17 +111,113 @@ public:
             seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         });
     }
+    // A snapshot outside the schedule, written now (the run stops after it).
+    std::string write_marked(const Simulation& sim, const std::string& label, const std::string& mark) {
+        wait();
+        return series_.write_marked(sim.nodes(), sim.real_count(), sim.time(), label, mark);
+    }
     void wait() {
         if (pending_.valid()) pending_.get();
     }
-    std::size_t count() const { return series_.count(); }
+    io::SnapshotSeries& series() { return series_; }
     double seconds() const { return seconds_; }
+    void add_seconds(double s) { seconds_ += s; }
 
 private:
     io::SnapshotSeries series_;
     std::future<void> pending_;
     double seconds_ = 0.0;
 };
+
+// What a checkpoint holds for the program besides the simulation (its user data): where the run
+// came from and how far its outputs had got.
+struct RunState {
+    std::string scene_file;
+    bool overwrite = false;
+    double wall_seconds = 0.0, output_seconds = 0.0;
+    double snapshot_slot = 0.0;
+    std::vector<io::PvdEntry> snapshots;  // the scheduled ones, in order
+};
+
+std::string encode(const RunState& s) {
+    std::string scene = s.scene_file;
+    std::replace(scene.begin(), scene.end(), '\n', '?');
+    std::string out = "gpa-run-state 1\n";
+    out += fmt::format("scene_file={}\noverwrite={}\nwall_seconds={:.17g}\noutput_seconds={:.17g}\nsnapshot_slot={:.17g}\n",
+                       scene, s.overwrite ? 1 : 0, s.wall_seconds, s.output_seconds, s.snapshot_slot);
+    for (const auto& e : s.snapshots) out += fmt::format("snapshot={:.17g} {}\n", e.time, e.file);
+    return out;
+}
+
+RunState decode(const std::string& text, const std::string& source) {
+    std::istringstream in(text);
+    std::string line;
+    if (!std::getline(in, line) || line != "gpa-run-state 1") {
+        throw CheckpointError(fmt::format("checkpoint {}: it holds no state of a gpa run", source));
+    }
+    RunState s;
+    while (std::getline(in, line)) {
+        const auto eq = line.find('=');
+        if (eq == std::string::npos) continue;
+        const std::string key = line.substr(0, eq), value = line.substr(eq + 1);
+        try {
+            if (key == "scene_file") s.scene_file = value;
+            else if (key == "overwrite") s.overwrite = value == "1";
+            else if (key == "wall_seconds") s.wall_seconds = std::stod(value);
+            else if (key == "output_seconds") s.output_seconds = std::stod(value);
+            else if (key == "snapshot_slot") s.snapshot_slot = std::stod(value);
+            else if (key == "snapshot") {
+                const auto space = value.find(' ');
+                if (space == std::string::npos) throw std::invalid_argument(value);
+                s.snapshots.push_back({std::stod(value.substr(0, space)), value.substr(space + 1)});
+            }
+        } catch (const std::exception&) {
+            throw CheckpointError(fmt::format("checkpoint {}: its run state is damaged at \"{}\"", source, line));
+        }
+    }
+    return s;
+}
+
+std::uint64_t free_bytes(const fs::path& folder) {
+    struct statvfs fs {};
+    if (::statvfs(folder.c_str(), &fs) != 0) return std::numeric_limits<std::uint64_t>::max();
+    return std::uint64_t(fs.f_bavail) * std::uint64_t(fs.f_frsize);
+}
+
+std::uint64_t file_bytes(const fs::path& file) {
+    std::error_code ec;
+    const auto size = fs::file_size(file, ec);
+    return ec ? 0 : size;
+}
+
+// The disk a run's outputs will take, from the size of its first snapshot, checked against the
+// free space of its folder before the first step.
+void check_disk(const Simulation& sim, const SnapshotSchedule& schedule, const fs::path& folder, std::uint64_t snapshot_bytes) {
+    const Scene& s = sim.scene();
+    // Steps: from the first time step to the end time, or max_steps, whichever is fewer.
+    double steps = std::numeric_limits<double>::infinity();
+    if (s.stop.end_time > 0.0 && sim.next_time_step() > 0.0) steps = std::ceil((s.stop.end_time - sim.time()) / sim.next_time_step());
+    if (s.stop.max_steps > 0) steps = std::min(steps, double(s.stop.max_steps - std::min(s.stop.max_steps, sim.steps())));
+    // Snapshots: the scheduled ones up to the end time (or the time max_steps reach at the first
+    // step's length), at most one per step.
+    double end = s.stop.end_time > 0.0 ? s.stop.end_time : std::numeric_limits<double>::infinity();
+    if (s.stop.max_steps > 0) end = std::min(end, sim.time() + steps * sim.next_time_step());
+    double snapshots = schedule.planned(end);
+    if (std::isfinite(steps)) snapshots = std::min(snapshots, steps + 2.0);
+    const double rows = std::isfinite(steps) ? steps / double(std::max<std::size_t>(s.output.history_every, 1)) + 2.0 : 0.0;
+    // A checkpoint is about the node store and the lists; two exist while one replaces the other.
+    const double checkpoint = 2.0 * double(sim.nodes().size()) * bytes_per_node_besides_lists(sim.nodes().dim()) / 2.0 +
+                              2.0 * 4.0 * double(sim.totals().pairs);
+    const double bytes = snapshots * double(snapshot_bytes) + rows * 400.0 + checkpoint;
+    const double available = double(free_bytes(folder));
+    if (bytes > available) {
+        throw LimitError(fmt::format("the run's outputs need an estimated {} of disk ({:.3g} snapshots of {} each{}, the "
+                                     "history and a checkpoint); the file system of '{}' has {} free",
+                                     format_bytes(bytes), snapshots, format_bytes(double(snapshot_bytes)),
+                                     std::isfinite(steps) && snapshots >= steps ? ", one per step" : "", folder.string(),
+                                     format_bytes(available)));
+    }
+}
 
 void print_report(const Simulation& sim) {
     const auto& t = sim.totals();
@@ -86,78 +233,293 @@ void print_report(const Simulation& sim) {
     }
 }
 
-}  // namespace
+std::string failure_json(const FailureSite& f) {
+    std::string position = "[";
+    for (int c = 0; c < f.dim; ++c) position += fmt::format("{}{:.10g}", c ? ", " : "", f.position[c]);
+    position += "]";
+    const auto quote = [](const std::string& s) {
+        std::string out = "\"";
+        for (const char c : s) {
+            if (c == '"' || c == '\\') out += '\\';
+            if (static_cast<unsigned char>(c) >= 0x20) out += c;
+        }
+        return out + "\"";
+    };
+    return fmt::format("{{\"step\": {}, \"time_s\": {:.10g}, \"phase\": {}, \"node\": {}, \"body\": {}, \"position_m\": {}, "
+                       "\"field\": {}}}",
+                       f.step, f.time, quote(f.phase), f.node ? std::to_string(*f.node) : "null", quote(f.body),
+                       f.node ? position : "null", quote(f.field));
+}
 
-int run_scene(const RunOptions& options) {
-    const Scene scene = read_scene(options.scene);
+// One run in its folder, from its first step or from a checkpoint.
+class Runner {
+public:
+    Runner(const RunOptions& options, Simulation& sim, io::RunFolder& folder, SceneSource source, RunState state)
+        : options_(options), sim_(sim), folder_(folder), source_(std::move(source)), state_(std::move(state)),
+          fingerprint_(io::scene_fingerprint(source_.text)), schedule_(sim.scene()), snapshots_(folder.partial()) {}
+
+    // A fresh run: the scene's copy, the history's header, the snapshot at t = 0, the disk check.
+    void start() {
+        io::write_text_file(folder_.partial() / scene_copy_name, source_.text);
+        history_.emplace(folder_.partial() / "history.csv", sim_.totals(), dimension_of(sim_.scene().geometry));
+        history_->write(sim_.totals());
+        last_row_ = sim_.steps();
+        snapshots_.write(sim_);
+        snapshots_.wait();  // its size is the disk estimate's unit
+        check_disk(sim_, schedule_, folder_.partial(), file_bytes(folder_.partial() / snapshots_.series().entries()[0].file));
+    }
+
+    // A resumed run: its outputs cut back to what they were at the checkpoint.
+    void resume(std::size_t checkpoint_step) {
+        const Scene& scene = sim_.scene();
+        const std::size_t every = std::max<std::size_t>(scene.output.history_every, 1);
+        history_.emplace(folder_.partial() / "history.csv", sim_.totals(), dimension_of(scene.geometry),
+                         [&](std::size_t step) { return step <= checkpoint_step && step % every == 0; });
+        last_row_ = checkpoint_step;
+        schedule_.set_last_slot(state_.snapshot_slot);
+        snapshots_.add_seconds(state_.output_seconds);
+        // Snapshots written after the checkpoint, and those of the interruption or failure, go.
+        std::error_code ec;
+        for (const auto& entry : fs::directory_iterator(folder_.partial(), ec)) {
+            const std::string name = entry.path().filename().string();
+            const bool kept = std::any_of(state_.snapshots.begin(), state_.snapshots.end(),
+                                          [&](const io::PvdEntry& e) { return e.file == name; });
+            const bool snapshot = name.rfind("particles_", 0) == 0 && entry.path().extension() == ".vtp";
+            const bool stale = name == "summary.json" || name == "profile.csv" || entry.path().extension() == ".tmp";
+            if ((snapshot && !kept) || stale) fs::remove(entry.path(), ec);
+        }
+        snapshots_.series().restore(state_.snapshots, state_.snapshots.size());
+        check_disk(sim_, schedule_, folder_.partial(),
+                   state_.snapshots.empty() ? 0 : file_bytes(folder_.partial() / state_.snapshots.front().file));
+    }
+
+    int run() {
+        const auto wall_start = std::chrono::steady_clock::now();
+        const auto wall = [&] {
+            return state_.wall_seconds + std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+        };
+        const Scene& scene = sim_.scene();
+        const std::size_t every = std::max<std::size_t>(scene.output.history_every, 1);
+        Progress progress(options_.quiet);
+        StopRequests stop;
+        auto last_checkpoint = std::chrono::steady_clock::now();
+        int stop_signal = 0;
+        try {
+            while (!sim_.finished()) {
+                if ((stop_signal = StopRequests::requested()) != 0) break;
+                sim_.step();
+                if (const auto& t = sim_.totals(); t.collapse_switches > 0 && !options_.quiet) {
+                    spdlog::warn("step {}: {} fixed node{} switched to variable connectivity because a lattice cell collapsed; "
+                                 "first: {}",
+                                 t.step, t.collapse_switches, t.collapse_switches == 1 ? "" : "s", t.first_collapse_switch);
+                }
+                const bool last = sim_.finished();
+                if (last || sim_.steps() % every == 0) write_row();
+                if (schedule_.due(sim_.time()) || last) snapshots_.write(sim_);
+                const auto now = std::chrono::steady_clock::now();
+                const bool by_steps = scene.output.checkpoint_every_steps > 0 && sim_.steps() % scene.output.checkpoint_every_steps == 0;
+                const bool by_time = scene.output.checkpoint_every_seconds > 0.0 &&
+                                     std::chrono::duration<double>(now - last_checkpoint).count() >= scene.output.checkpoint_every_seconds;
+                if (!last && (by_steps || by_time)) {
+                    write_checkpoint(wall());
+                    last_checkpoint = std::chrono::steady_clock::now();
+                }
+                progress.update(sim_);
+            }
+            progress.finish(sim_);
+            snapshots_.wait();
+        } catch (const StepFailure& f) {
+            progress.finish(sim_);
+            return failed(f.what(), &f.site(), wall());
+        } catch (const std::exception& e) {
+            progress.finish(sim_);
+            return failed(e.what(), nullptr, wall());
+        }
+        if (stop_signal != 0) return interrupted(stop_signal, wall());
+        return finished(wall());
+    }
+
+private:
+    void write_row() {
+        history_->write(sim_.totals());
+        last_row_ = sim_.steps();
+    }
+
+    void write_checkpoint(double wall_seconds) {
+        snapshots_.wait();  // the series on disk is the one the checkpoint lists
+        RunState s = state_;
+        s.scene_file = source_.label;
+        s.overwrite = options_.overwrite || state_.overwrite;
+        s.wall_seconds = wall_seconds;
+        s.output_seconds = snapshots_.seconds();
+        s.snapshot_slot = schedule_.last_slot();
+        s.snapshots.clear();
+        for (const auto& e : snapshots_.series().entries()) {
+            if (e.name.empty()) s.snapshots.push_back(e);
+        }
+        io::write_checkpoint(folder_.partial() / checkpoint_name, sim_, fingerprint_, encode(s));
+    }
+
+    io::RunSummary summary(const std::string& status, const std::string& message, double wall_seconds) {
+        io::RunSummary s;
+        s.scene_file = state_.scene_file.empty() ? source_.label : state_.scene_file;
+        s.status = status;
+        s.message = message;
+        s.snapshots = snapshots_.series().count();
+        s.output_seconds = snapshots_.seconds();
+        s.wall_seconds = wall_seconds;
+        return s;
+    }
+
+    int finished(double wall_seconds) {
+        try {
+            io::write_profile(folder_.partial() / "profile.csv", sim_);
+            io::write_summary(folder_.partial() / "summary.json", sim_, summary("finished", sim_.stop_reason(), wall_seconds));
+            std::error_code ec;
+            fs::remove(folder_.partial() / checkpoint_name, ec);  // a finished run is not resumed
+            folder_.commit();
+        } catch (const std::exception& e) {
+            return failed(e.what(), nullptr, wall_seconds);
+        }
+        if (!options_.quiet) {
+            const Scene& scene = sim_.scene();
+            fmt::print("{}\n", scene.name.empty() ? "run finished" : scene.name);
+            print_report(sim_);
+            fmt::print("  wall time {:.1f} s on {} thread{}\n", wall_seconds, sim_.threads(), sim_.threads() == 1 ? "" : "s");
+        }
+        fmt::print("output: {} (open particles.pvd in ParaView; history.csv, summary.json)\n", folder_.final_path().string());
+        return 0;
+    }
+
+    int interrupted(int signo, double wall_seconds) {
+        const char* name = signo == SIGTERM ? "SIGTERM" : "SIGINT";
+        std::string problem;
+        try {
+            snapshots_.wait();
+            if (last_row_ != sim_.steps()) write_row();
+            snapshots_.write_marked(sim_, fmt::format("interrupted_step{:07d}", sim_.steps()),
+                                    fmt::format("interrupted at step {}", sim_.steps()));
+            write_checkpoint(wall_seconds);
+            io::write_summary(folder_.partial() / "summary.json", sim_,
+                              summary("interrupted",
+                                      fmt::format("stopped by {} after step {} at t = {:.6g} us", name, sim_.steps(), sim_.time() * 1e6),
+                                      wall_seconds));
+        } catch (const std::exception& e) {
+            problem = e.what();
+        }
+        fmt::print(stderr, "gpa: the run was stopped by {} after step {} at t = {:.4g} us{}\n", name, sim_.steps(), sim_.time() * 1e6,
+                   problem.empty() ? fmt::format("; resume it with: gpa run --resume {}", folder_.final_path().string())
+                                   : fmt::format(", and saving it failed: {}", problem));
+        return 128 + signo;
+    }
+
+    int failed(const std::string& message, const FailureSite* site, double wall_seconds) {
+        std::string also;
+        try {
+            snapshots_.wait();
+        } catch (const std::exception& e) {
+            also += fmt::format("; a snapshot could not be written either: {}", e.what());
+        }
+        try {
+            if (last_row_ != sim_.totals().step) write_row();
+        } catch (const std::exception&) {
+        }
+        try {
+            if (site) {
+                // The failing step as it was when it failed, marked beside the scheduled ones.
+                snapshots_.write_marked(sim_, fmt::format("failed_step{:07d}", site->step), fmt::format("failed step {}", site->step));
+            }
+        } catch (const std::exception& e) {
+            also += fmt::format("; the snapshot of the failing step could not be written: {}", e.what());
+        }
+        try {
+            auto s = summary("failed", message, wall_seconds);
+            if (site) s.failure_json = failure_json(*site);
+            io::write_summary(folder_.partial() / "summary.json", sim_, s);
+        } catch (const std::exception& e) {
+            also += fmt::format("; summary.json could not be written: {}", e.what());
+        }
+        const bool resumable = fs::exists(folder_.partial() / checkpoint_name);
+        fmt::print(stderr, "gpa: the run failed: {}{}; what was written is in {}{}\n", message, also, folder_.partial().string(),
+                   resumable && !site ? fmt::format(" (gpa run --resume {} continues it from its last checkpoint)",
+                                                    folder_.final_path().string())
+                                      : "");
+        return 3;
+    }
+
+    const RunOptions& options_;
+    Simulation& sim_;
+    io::RunFolder& folder_;
+    SceneSource source_;
+    RunState state_;
+    std::string fingerprint_;
+    SnapshotSchedule schedule_;
+    SnapshotWriter snapshots_;
+    std::optional<io::HistoryWriter> history_;
+    std::size_t last_row_ = 0;  // the step of the last history row
+};
+
+int fresh_run(const RunOptions& options) {
+    SceneSource source = read_source(options.scene);
+    const Scene scene = io::parse_scene(source.text, source.name);
     const fs::path output = options.output.value_or(default_output_folder("runs", scene.name));
-    const auto wall_start = std::chrono::steady_clock::now();
-    Simulation sim(scene, options.threads);  // before the folder: an impossible scene leaves nothing behind
+    Simulation sim(scene, options.threads, options.memory);  // before the folder: an impossible scene leaves nothing behind
     io::RunFolder folder(output, options.overwrite);
     if (!options.quiet) {
         spdlog::info("{}: {} nodes, {} thread{}, output in {}", scene.name.empty() ? "scene" : scene.name, sim.real_count(),
                      sim.threads(), sim.threads() == 1 ? "" : "s", folder.partial().string());
     }
-    io::HistoryWriter history(folder.partial() / "history.csv", sim.totals(), dimension_of(scene.geometry));
-    SnapshotWriter snapshots(folder.partial());
-    io::RunSummary summary;
-    summary.scene_file = options.scene ? options.scene->string() : "(built-in default)";
-    Progress progress(options.quiet);
-    const double interval = snapshot_interval(scene);
-    double next_snapshot = interval;
-    history.write(sim.totals());
-    snapshots.write(sim);
+    RunState state;
+    state.scene_file = source.label;
+    state.overwrite = options.overwrite;
+    Runner runner(options, sim, folder, std::move(source), state);
     try {
-        while (!sim.finished()) {
-            sim.step();
-            if (const auto& t = sim.totals(); t.collapse_switches > 0 && !options.quiet) {
-                spdlog::warn("step {}: {} fixed node{} switched to variable connectivity because a lattice cell collapsed; first: {}",
-                             t.step, t.collapse_switches, t.collapse_switches == 1 ? "" : "s", t.first_collapse_switch);
-            }
-            const bool last = sim.finished();
-            if (last || sim.steps() % std::max<std::size_t>(scene.output.history_every, 1) == 0) history.write(sim.totals());
-            if (last || (interval > 0.0 && sim.time() >= next_snapshot * (1.0 - 1e-9))) {
-                snapshots.write(sim);
-                while (interval > 0.0 && next_snapshot <= sim.time() * (1.0 + 1e-9)) next_snapshot += interval;
-            }
-            progress.update(sim);
-        }
-        progress.finish(sim);
-        snapshots.wait();
-    } catch (const std::exception& e) {
-        progress.finish(sim);
-        try {
-            snapshots.wait();
-        } catch (...) {
-        }
-        summary.status = "failed";
-        summary.message = e.what();
-        summary.snapshots = snapshots.count();
-        summary.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
-        try {
-            history.write(sim.totals());
-            io::write_summary(folder.partial() / "summary.json", sim, summary);
-        } catch (...) {
-        }
-        fmt::print(stderr, "gpa: the run failed at t = {:.4g} us, step {}: {}\n", sim.time() * 1e6, sim.steps(), e.what());
-        fmt::print(stderr, "gpa: what was written so far is in {}\n", folder.partial().string());
-        return 3;
+        runner.start();
+    } catch (...) {
+        // Refused before the first step (the disk estimate, an unwritable folder): nothing is kept.
+        std::error_code ec;
+        fs::remove_all(folder.partial(), ec);
+        throw;
     }
-    summary.message = sim.stop_reason();
-    summary.snapshots = snapshots.count();
-    summary.output_seconds = snapshots.seconds();
-    summary.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
-    io::write_summary(folder.partial() / "summary.json", sim, summary);
-    io::write_profile(folder.partial() / "profile.csv", sim);
-    folder.commit();
-    if (!options.quiet) {
-        fmt::print("{}\n", scene.name.empty() ? "run finished" : scene.name);
-        print_report(sim);
-        fmt::print("  wall time {:.1f} s on {} thread{}\n", summary.wall_seconds, sim.threads(), sim.threads() == 1 ? "" : "s");
-    }
-    fmt::print("output: {} (open particles.pvd in ParaView; history.csv, summary.json)\n", folder.final_path().string());
-    return 0;
+    return runner.run();
 }
+
+int resumed_run(const RunOptions& options) {
+    if (options.output) throw io::OutputError("--resume continues a run in its own folder: give the folder to --resume, not -o");
+    io::RunFolder folder(*options.resume, false, io::RunFolder::Mode::Resume);
+    const fs::path checkpoint = folder.partial() / checkpoint_name;
+    if (!fs::exists(checkpoint)) {
+        throw io::OutputError(fmt::format("'{}' holds no checkpoint: the run stopped before it wrote one (output.checkpoint_every); "
+                                          "start it again",
+                                          folder.partial().string()));
+    }
+    // The scene the run started with: its copy in the folder, or the file given, which must be
+    // the same.
+    const fs::path copy = folder.partial() / scene_copy_name;
+    SceneSource source = options.scene ? read_source(options.scene) : SceneSource{io::read_scene_text(copy), copy.string(), copy.string()};
+    const CheckpointInfo info = io::checkpoint_info(checkpoint);
+    if (info.scene_fingerprint != io::scene_fingerprint(source.text)) {
+        throw CheckpointError(fmt::format("'{}' is not the scene the run in '{}' started with (its copy is '{}')", source.name,
+                                          folder.partial().string(), copy.string()));
+    }
+    const Scene scene = io::parse_scene(source.text, source.name);
+    Simulation sim(scene, options.threads, options.memory);
+    const std::string user = io::read_checkpoint(checkpoint, sim, io::scene_fingerprint(source.text));
+    RunState state = decode(user, checkpoint.string());
+    folder.set_overwrite(state.overwrite);
+    source.label = state.scene_file;
+    if (!options.quiet) {
+        spdlog::info("{}: resuming at step {} (t = {:.4g} us), {} nodes, {} thread{}, output in {}", scene.name, info.step,
+                     info.time * 1e6, sim.real_count(), sim.threads(), sim.threads() == 1 ? "" : "s", folder.partial().string());
+    }
+    Runner runner(options, sim, folder, std::move(source), std::move(state));
+    runner.resume(info.step);
+    return runner.run();
+}
+
+}  // namespace
+
+int run_scene(const RunOptions& options) { return options.resume ? resumed_run(options) : fresh_run(options); }
 
 fs::path default_output_folder(const std::string& root, const std::string& scene_name) {
     std::string slug;
@@ -169,9 +531,9 @@ fs::path default_output_folder(const std::string& root, const std::string& scene
     return fs::path(root) / fmt::format("{}-{}", slug, stamp);
 }
 
-int check_scene(const fs::path& file) {
+int check_scene(const fs::path& file, const MemoryLimit& memory) {
     const Scene scene = io::load_scene(file);
-    Simulation sim(scene, 1);  // builds the nodes: every check of set-up runs
+    Simulation sim(scene, 1, memory);  // builds the nodes: every check of set-up runs
     fmt::print("{}: OK\n", file.string());
     fmt::print("  {} ({}), {} bod{}, {} real nodes, {} ghost nodes at the start\n", scene.name, name_of(scene.geometry),
                scene.bodies.size(), scene.bodies.size() == 1 ? "y" : "ies", sim.real_count(), sim.totals().ghost_nodes);

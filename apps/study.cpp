@@ -208,7 +208,7 @@ int run_study(const StudyOptions& options) {
         // The coarsest lattice of each variant is set up once, so that a scene the engine cannot
         // start (a fixed body apart from a plane, ...) is refused before anything is written.
         try {
-            Simulation check(by_variant[v].front().scene, 1);
+            Simulation check(by_variant[v].front().scene, 1, options.memory);
         } catch (const InputError& e) {
             throw InputError(variants.size() > 1 || !options.variants.empty()
                                  ? fmt::format("--variant {}: {}", variants[v].name, e.what())
@@ -266,7 +266,7 @@ int run_study(const StudyOptions& options) {
         std::unique_ptr<Simulation> sim;
         const auto start = std::chrono::steady_clock::now();
         try {
-            sim = std::make_unique<Simulation>(p.scene, p.threads);
+            sim = std::make_unique<Simulation>(p.scene, p.threads, options.memory);
             io::RunProbe probe(*sim);
             c.nodes = sim->real_count();
             c.threads = sim->threads();

@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "gpa/engine/limits.hpp"
+
 namespace gpa::app {
 
 struct StudyOptions {
@@ -17,6 +19,7 @@ struct StudyOptions {
     std::string threads = "0";                    // thread counts, as typed
     bool overwrite = false;
     bool quiet = false;
+    MemoryLimit memory;  // --max-memory, for every case
 };
 
 // Runs the study; returns the process exit code (0, or 3 when a case failed; the outputs are

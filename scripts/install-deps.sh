@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Installs the Debian packages gpa needs to build, test and benchmark, and only those that are
+# Installs the Debian packages gpa needs to build, test, sanitize, fuzz and benchmark, and only those that are
 # missing. Runs `apt-get update` once, and only when something has to be installed.
 # Usage: scripts/install-deps.sh [--with-peers]   (--with-peers adds python3-pysph for the peer run)
 set -euo pipefail
@@ -9,6 +9,7 @@ packages=(
   libtbb-dev libeigen3-dev libfmt-dev libspdlog-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev libtomlplusplus-dev nlohmann-json3-dev
+  clang libclang-rt-14-dev llvm   # scripts/sanitize.sh: sanitizers, libFuzzer, llvm-symbolizer
 )
 if [[ "${1:-}" == "--with-peers" ]]; then
   packages+=(python3-pysph)

@@ -188,6 +188,9 @@ TEST(NeighbourSkin, CutCandidatesEqualAFullSearchEveryStep) {
         scene.bodies[0].origin[1] += 0.5e-3;
         scene.stop = {};
         scene.stop.max_steps = 100000;
+        // 4 nodes across at 300 m/s: the energy error of this coarse impact passes 3 % near step
+        // 157; the case is here for its contacts, not its energy, so the energy guard is off.
+        scene.stop.energy_error = 0.0;
         cases.push_back({"elastic bar arriving at a lift-off plane", scene, 600});
     }
     {

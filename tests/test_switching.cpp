@@ -148,10 +148,13 @@ TEST(LatticeCells, CollapsedCellsOfAnAutomaticBodySwitchAtOnce) {
         bool stopped = false;
         try {
             while (!fixed.finished()) fixed.step();
-        } catch (const NumericalError& e) {
+        } catch (const StepFailure& e) {
             stopped = true;
             const std::string message = e.what();
-            EXPECT_NE(message.find("body \"cylinder\", node "), std::string::npos) << message;
+            EXPECT_EQ(e.site().phase, "switching") << message;
+            EXPECT_TRUE(e.site().node.has_value()) << message;
+            EXPECT_EQ(e.site().body, "cylinder") << message;
+            EXPECT_EQ(e.site().field, "lattice cell volume ratio") << message;
             EXPECT_NE(message.find("connectivity = \"automatic\""), std::string::npos) << message;
         }
         ASSERT_TRUE(stopped) << "the fixed cylinder no longer collapses: the test needs another case";

@@ -11,6 +11,7 @@
 #include <tbb/parallel_reduce.h>
 
 #include "gpa/engine/errors.hpp"
+#include "gpa/engine/state_io.hpp"
 
 namespace gpa {
 
@@ -366,6 +367,56 @@ std::vector<double> GhostSet::normal_reactions(const NodeStore& nodes, std::size
         }
     }
     return reaction;
+}
+
+void GhostSet::write_state(StateWriter& out) const {
+    out.tag("GHST");
+    out.value<std::uint64_t>(planes_.size());
+    out.value<std::uint64_t>(masks_.size());
+    for (const auto& index : index_) out.array(index);
+    out.array(source_);
+    out.array(mask_);
+    out.array(slot_);
+    out.array(sources_sorted_);
+    out.value<std::uint8_t>(keep_between_searches_ ? 1 : 0);
+    write_rows(out, resolved_);
+}
+
+void GhostSet::read_state(StateReader& in, std::size_t real_count, std::size_t node_count) {
+    in.tag("GHST");
+    if (in.value<std::uint64_t>() != planes_.size() || in.value<std::uint64_t>() != masks_.size()) {
+        in.fail("its planes are not the scene's");
+    }
+    for (auto& index : index_) {
+        in.array(index);
+        if (!index.empty() && index.size() != real_count) in.fail("a ghost table has the wrong length (a damaged checkpoint)");
+        for (const std::int32_t g : index) {
+            if (g < -1 || g >= static_cast<std::int64_t>(node_count)) in.fail("a ghost table names a node that does not exist");
+        }
+    }
+    in.array(source_);
+    in.array(mask_);
+    in.array(slot_);
+    in.array(sources_sorted_);
+    const std::size_t ghosts = source_.size();
+    if (mask_.size() != ghosts || slot_.size() != ghosts || real_count + ghosts != node_count) {
+        in.fail("its ghosts do not match its nodes (a damaged checkpoint)");
+    }
+    for (std::size_t k = 0; k < ghosts; ++k) {
+        if (source_[k] >= real_count || slot_[k] >= masks_.size()) in.fail("a ghost has no source (a damaged checkpoint)");
+    }
+    for (const NodeIndex s : sources_sorted_) {
+        if (s >= real_count) in.fail("a ghost source does not exist (a damaged checkpoint)");
+    }
+    keep_between_searches_ = in.value<std::uint8_t>() != 0;
+    in.array(resolved_.offsets);
+    in.array(resolved_.indices);
+    if (resolved_.offsets.empty() || resolved_.offsets.back() != resolved_.indices.size()) {
+        in.fail("the resolved mirror lists are damaged");
+    }
+    for (const NodeIndex g : resolved_.indices) {
+        if (g >= node_count) in.fail("a resolved mirror names a node that does not exist");
+    }
 }
 
 }  // namespace gpa

@@ -198,6 +198,7 @@ void find_neighbours(const NodeStore& nodes, double a, std::size_t centres, Comp
         }
     });
     for (std::size_t i = 0; i < centres; ++i) out.offsets[i + 1] += out.offsets[i];
+    if (scratch.check_entries) scratch.check_entries(out.offsets[centres]);
     resize_with_slack(out.indices, out.offsets[centres]);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, centres, search_block), [&](const tbb::blocked_range<std::size_t>& r) {
         for (std::size_t i = r.begin(); i != r.end(); ++i) {

@@ -1,11 +1,13 @@
 #include "gpa/engine/node_store.hpp"
 
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 #include <fmt/format.h>
 
 #include "gpa/engine/errors.hpp"
+#include "gpa/engine/state_io.hpp"
 
 namespace gpa {
 
@@ -197,6 +199,56 @@ void update_size_weights(NodeStore& nodes, std::size_t first, std::size_t last) 
     } else {
         for (std::size_t i = first; i < last; ++i) nodes.size_weight[i] = nodes.volume[i];
     }
+}
+
+// --- checkpoints --------------------------------------------------------------------------
+
+// (Also used by simulation.cpp and ghosts.cpp, declared in state_io.hpp.)
+void write_rows(StateWriter& out, const CompressedRows& rows) {
+    out.array(rows.offsets);
+    out.array(rows.indices);
+}
+
+void read_rows(StateReader& in, CompressedRows& rows, std::size_t row_count, std::size_t index_limit) {
+    in.array(rows.offsets);
+    in.array(rows.indices);
+    const bool any_count = row_count == std::numeric_limits<std::size_t>::max();
+    if (rows.offsets.empty() || (!any_count && rows.offsets.size() != row_count + 1) || rows.offsets.front() != 0 ||
+        rows.offsets.back() != rows.indices.size()) {
+        in.fail("a neighbour list does not fit its rows (a damaged checkpoint)");
+    }
+    for (std::size_t i = 0; i + 1 < rows.offsets.size(); ++i) {
+        if (rows.offsets[i] > rows.offsets[i + 1]) in.fail("a neighbour list's offsets decrease (a damaged checkpoint)");
+    }
+    for (const NodeIndex j : rows.indices) {
+        if (j >= index_limit) in.fail("a neighbour list names a node that does not exist (a damaged checkpoint)");
+    }
+}
+
+void NodeStore::write_state(StateWriter& out) const {
+    out.tag("NODE");
+    out.value<std::int32_t>(static_cast<std::int32_t>(geometry_));
+    out.value<std::uint64_t>(size());
+    // for_each_field only reads here.
+    const_cast<NodeStore*>(this)->for_each_field([&](auto& field) { out.array(field); });
+    write_rows(out, fixed_neighbours);
+    write_rows(out, fixed_mirrors);
+    out.array(fixed_mirror_planes);
+}
+
+void NodeStore::read_state(StateReader& in) {
+    in.tag("NODE");
+    if (in.value<std::int32_t>() != static_cast<std::int32_t>(geometry_)) in.fail("its nodes are of another geometry");
+    const auto count = in.value<std::uint64_t>();
+    if (count > 0xFFFFFFFFu) in.fail("its node count is out of range (a damaged checkpoint)");
+    for_each_field([&](auto& field) {
+        in.array(field);
+        if (field.size() != count) in.fail("a node field has the wrong length (a damaged checkpoint)");
+    });
+    read_rows(in, fixed_neighbours, count, count);
+    read_rows(in, fixed_mirrors, count, count);
+    in.array(fixed_mirror_planes);
+    if (fixed_mirror_planes.size() != fixed_mirrors.entries()) in.fail("the mirrored lattice lists are damaged");
 }
 
 }  // namespace gpa

@@ -18,6 +18,7 @@ struct PhaseGraph::Impl {
     std::vector<PhaseTime> times;
     std::vector<std::function<void()>> bodies;
     std::exception_ptr failure;
+    std::size_t failed_phase = 0;  // the phase that threw `failure`
 };
 
 PhaseGraph::PhaseGraph() : impl_(std::make_unique<Impl>()) {}
@@ -36,6 +37,7 @@ void PhaseGraph::add(std::string name, std::function<void()> body) {
                 im.bodies[k]();
             } catch (...) {
                 im.failure = std::current_exception();
+                im.failed_phase = k;
             }
             im.times[k].seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
             ++im.times[k].calls;
@@ -58,6 +60,18 @@ void PhaseGraph::run() {
 }
 
 std::vector<PhaseTime> PhaseGraph::times() const { return impl_->times; }
+
+std::string PhaseGraph::failed_phase() const {
+    return impl_->failure ? impl_->times[impl_->failed_phase].name : std::string();
+}
+
+void PhaseGraph::restore_times(const std::vector<PhaseTime>& times) {
+    for (auto& mine : impl_->times) {
+        for (const auto& t : times) {
+            if (t.name == mine.name) mine = t;
+        }
+    }
+}
 
 std::vector<std::string> PhaseGraph::names() const {
     std::vector<std::string> out;

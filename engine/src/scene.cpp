@@ -292,6 +292,9 @@ void check_stop(const StopCriteria& s) {
     if (!(s.kinetic_energy_fraction >= 0.0 && s.kinetic_energy_fraction < 1.0)) {
         fail(fmt::format("stop.kinetic_energy_fraction = {} is outside [0, 1)", s.kinetic_energy_fraction));
     }
+    if (!(s.energy_error >= 0.0 && finite(s.energy_error))) {
+        fail(fmt::format("stop.energy_error = {} must be a finite fraction >= 0 (0 = no energy guard)", s.energy_error));
+    }
     if (s.end_time == 0.0 && s.kinetic_energy_fraction == 0.0 && s.max_steps == 0) {
         fail("stop: no end condition; set stop.end_time, stop.kinetic_energy_fraction or stop.max_steps");
     }
@@ -302,6 +305,9 @@ void check_output(const OutputOptions& o) {
         fail(fmt::format("output.snapshot_interval = {} must be a finite time >= 0 (s)", o.snapshot_interval));
     }
     if (o.history_every == 0) fail("output.history_every must be at least 1 (steps between history rows)");
+    if (!(o.checkpoint_every_seconds >= 0.0 && finite(o.checkpoint_every_seconds))) {
+        fail(fmt::format("output.checkpoint_every = {} s must be a finite wall-clock time >= 0", o.checkpoint_every_seconds));
+    }
 }
 
 }  // namespace

@@ -1,9 +1,12 @@
 #include "gpa/engine/simulation.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <optional>
+#include <utility>
 
 #include <fmt/format.h>
 #include <tbb/blocked_range.h>
@@ -21,7 +24,9 @@
 #include "gpa/engine/neighbours.hpp"
 #include "gpa/engine/parallel.hpp"
 #include "gpa/engine/smoothing.hpp"
+#include "gpa/engine/state_io.hpp"
 #include "gpa/engine/stress.hpp"
+#include "gpa/engine/version.hpp"
 
 namespace gpa {
 
@@ -109,6 +114,13 @@ struct Simulation::Impl {
     std::vector<double> reaction;
     Totals totals;
     std::string stop_reason;
+
+    // --- limits, failure reports and checkpoints (the last section of this file) ---------
+    MemoryLimit memory_limit;
+    StepFailure step_failure(const std::exception& e, const std::string& phase) const;
+    void check_step(double time_before);  // the energy guard; time must advance
+    void write_state(StateWriter& out) const;
+    void read_state(StateReader& in);
 
     Impl(Scene s, int thread_count) : scene(std::move(s)), threads(thread_count), nodes(scene.geometry) {}
 
@@ -505,12 +517,14 @@ void Simulation::Impl::switching() {
         const bool collapsed = !(cell_ratio[i] > collapsed_cell_ratio);
         if (body_mode[static_cast<std::size_t>(nodes.body[i])] == ConnectivityMode::Fixed) {
             if (!collapsed) continue;
-            throw NumericalError(fmt::format(
-                "{}, step {}, t = {:.4g} us: a lattice cell of this fixed-connectivity node has {} (volume ratio {:.3g}); "
-                "a fixed lattice cannot follow this deformation. Give the body connectivity = \"automatic\" (nodes switch "
-                "to variable connectivity as they deform) or \"variable\"; a finer spacing helps only where the lattice "
-                "tangles at a sharp gradient, not under large flow",
-                where(i), steps + 1, time * 1e6, cell_ratio[i] <= 0.0 ? "inverted" : "collapsed", cell_ratio[i]));
+            // The step's report adds the step, time, phase, body and position (Simulation::step).
+            throw NumericalError(
+                fmt::format("a lattice cell of this fixed-connectivity node has {} (volume ratio {:.3g}); a fixed lattice "
+                            "cannot follow this deformation. Give the body connectivity = \"automatic\" (nodes switch to "
+                            "variable connectivity as they deform) or \"variable\"; a finer spacing helps only where the "
+                            "lattice tangles at a sharp gradient, not under large flow",
+                            cell_ratio[i] <= 0.0 ? "inverted" : "collapsed", cell_ratio[i]),
+                i, "lattice cell volume ratio");
         }
         if (!collapsed && !(nodes.plastic_strain[i] > threshold)) continue;
         // The candidate lists hold every node within reach of a fixed centre too, so they stay
@@ -561,7 +575,8 @@ void Simulation::Impl::time_step() {
                 throw NumericalError(fmt::format("node {} at ({:.6g}, {:.6g}) m at t = {:.6g} s: its stable time step is not "
                                                  "a number (stable length {}, sound speed {}, volume {})",
                                                  i, nodes.position[0][i], nodes.position[1][i], time,
-                                                 nodes.stable_length[i], nodes.sound_speed[i], nodes.volume[i]));
+                                                 nodes.stable_length[i], nodes.sound_speed[i], nodes.volume[i]),
+                                     i, "stable time step");
             }
         }
         throw NumericalError(fmt::format("the stable time step is not a number at t = {} s", time));
@@ -758,7 +773,24 @@ void Simulation::Impl::build_phase_graph() {
     });
 }
 
-Simulation::Simulation(Scene scene, int threads) : impl_(std::make_unique<Impl>(std::move(scene), threads)) {
+Simulation::Simulation(Scene scene, int threads, MemoryLimit memory)
+    : impl_(std::make_unique<Impl>(std::move(scene), threads)) {
+    // Sizes from the input, checked before they are allocated: the nodes here, the neighbour
+    // lists before every search.
+    validate_scene(impl_->scene);
+    check_scene_memory(impl_->scene, memory);
+    impl_->memory_limit = std::move(memory);
+    impl_->search_scratch.check_entries = [im = impl_.get()](std::size_t entries) {
+        const int dim = im->dim();
+        const double bytes = double(im->nodes.size()) * bytes_per_node_besides_lists(dim) +
+                             double(entries) * bytes_per_list_entry;
+        if (bytes > double(limit_bytes(im->memory_limit))) {
+            throw LimitError(fmt::format("the neighbour lists would hold {} pairs ({:.3g} per node), an estimated {} of "
+                                         "memory with the nodes; {}",
+                                         entries, double(entries) / double(std::max<std::size_t>(im->real, 1)),
+                                         format_bytes(bytes), describe_limit(im->memory_limit)));
+        }
+    };
     impl_->threads.run([this] {
         dispatch_geometry(impl_->scene.geometry, [this](auto g) { impl_->setup<decltype(g)>(); });
     });
@@ -771,12 +803,17 @@ void Simulation::step() {
         throw NumericalError("Simulation::step: an earlier step failed and left the state half-updated");
     }
     if (finished()) return;
+    const double time_before = impl_->time;
     try {
         impl_->threads.run([this] { impl_->graph->run(); });
+    } catch (const std::exception& e) {
+        impl_->failed = true;
+        throw impl_->step_failure(e, impl_->graph->failed_phase());
     } catch (...) {
         impl_->failed = true;
         throw;
     }
+    impl_->check_step(time_before);
 }
 
 bool Simulation::finished() const {
@@ -817,4 +854,350 @@ std::vector<std::string> Simulation::phases() const { return impl_->graph->names
 double Simulation::node_steps() const { return impl_->node_steps; }
 const CompressedRows& Simulation::neighbour_lists() const { return impl_->lists; }
 
+// --- limits, failure reports and checkpoints ----------------------------------------------
+
+namespace {
+
+std::string component_name(int dim, int c) { return dim == 2 ? (c == 0 ? "x" : "z") : std::string(1, "xyz"[c]); }
+
+std::string stress_name(GeometryKind g, int c) {
+    if (g == GeometryKind::ThreeD) return std::array<const char*, 6>{"xx", "yy", "zz", "yz", "xz", "xy"}[c];
+    return std::array<const char*, 4>{"xx", "zz", "xz", g == GeometryKind::Axisymmetric ? "tt" : "yy"}[c];
+}
+
+// The first real node (lowest index) with a non-finite value in a field a step writes, and
+// that field's name.
+std::optional<std::pair<std::size_t, std::string>> first_non_finite(const NodeStore& n, std::size_t real) {
+    const int d = n.dim();
+    std::vector<std::pair<std::string, const std::vector<double>*>> fields;
+    for (int c = 0; c < d; ++c) fields.push_back({"position " + component_name(d, c), &n.position[c]});
+    for (int c = 0; c < d; ++c) fields.push_back({"velocity " + component_name(d, c), &n.velocity[c]});
+    fields.push_back({"volume", &n.volume});
+    fields.push_back({"diameter", &n.diameter});
+    fields.push_back({"volumetric strain", &n.volumetric_strain});
+    for (int c = 0; c < d * d; ++c) {
+        fields.push_back({"velocity gradient " + component_name(d, c / d) + component_name(d, c % d), &n.velocity_gradient[c]});
+    }
+    for (int c = 0; c < d; ++c) fields.push_back({"alpha " + component_name(d, c), &n.alpha[c]});
+    for (int c = 0; c < stress_components(d); ++c) {
+        fields.push_back({"deviatoric stress " + stress_name(n.geometry(), c), &n.deviatoric_stress[c]});
+    }
+    fields.push_back({"pressure", &n.pressure});
+    fields.push_back({"viscous pressure", &n.viscous_pressure});
+    fields.push_back({"sound speed", &n.sound_speed});
+    fields.push_back({"internal energy", &n.internal_energy});
+    fields.push_back({"stable length", &n.stable_length});
+    for (int c = 0; c < d; ++c) fields.push_back({"force " + component_name(d, c), &n.force[c]});
+    std::optional<std::pair<std::size_t, std::string>> found;
+    for (const auto& [name, field] : fields) {
+        const std::size_t count = std::min(real, field->size());
+        for (std::size_t i = 0; i < count && (!found || i < found->first); ++i) {
+            if (!std::isfinite((*field)[i])) {
+                found = std::pair{i, name};
+                break;
+            }
+        }
+    }
+    return found;
+}
+
+std::string describe_site(const FailureSite& f) {
+    std::string text = fmt::format("step {} at t = {:.6g} us, phase \"{}\"", f.step, f.time * 1e6, f.phase);
+    if (f.node) {
+        text += fmt::format(": node {}", *f.node);
+        if (!f.body.empty()) text += fmt::format(" of body \"{}\"", f.body);
+        text += " at (";
+        for (int c = 0; c < f.dim; ++c) text += fmt::format("{}{:.6g}", c ? ", " : "", f.position[c] * 1e3);
+        text += ") mm";
+    }
+    if (!f.field.empty()) text += fmt::format(", field {}", f.field);
+    return text + ": " + f.cause;
+}
+
+}  // namespace
+
+StepFailure Simulation::Impl::step_failure(const std::exception& e, const std::string& phase) const {
+    FailureSite site;
+    site.step = steps + 1;  // the totals phase counts a step when it completes
+    site.time = time;
+    site.phase = phase.empty() ? "step" : phase;
+    site.dim = dim();
+    site.cause = e.what();
+    if (const auto* numerical = dynamic_cast<const NumericalError*>(&e); numerical && numerical->node()) {
+        site.node = numerical->node();
+        site.field = numerical->field();
+    } else if (dynamic_cast<const NumericalError*>(&e) || dynamic_cast<const InputError*>(&e)) {
+        // The kernel did not say which node: the first with a value that is not a number.
+        if (const auto bad = first_non_finite(nodes, real)) {
+            site.node = bad->first;
+            site.field = bad->second;
+        }
+    }
+    if (site.node && *site.node < nodes.size()) {
+        const std::size_t i = *site.node;
+        const auto b = static_cast<std::size_t>(nodes.body[i]);
+        if (b < scene.bodies.size()) site.body = scene.bodies[b].name;
+        for (int c = 0; c < dim(); ++c) site.position[c] = nodes.position[c][i];
+    }
+    return StepFailure(describe_site(site), site);
+}
+
+void Simulation::Impl::check_step(double time_before) {
+    if (!(time > time_before)) {
+        failed = true;
+        FailureSite site{steps, time, "move", {}, {}, {0, 0, 0}, dim(), "time", {}};
+        site.cause = fmt::format("the time step {:.3g} s no longer advances the time (it is below the rounding step of "
+                                 "t = {:.6g} s); a time loop would never end",
+                                 dt_half, time);
+        throw StepFailure(describe_site(site), site);
+    }
+    // The energy guard (stop.energy_error): an unstable run gains energy it was never given.
+    const double limit = scene.stop.energy_error;
+    if (limit > 0.0 && !(std::abs(totals.energy_error) <= limit)) {
+        failed = true;
+        // The fastest node: where an instability has put the energy it made.
+        std::size_t fastest = 0;
+        double top = -1.0;
+        for (std::size_t i = 0; i < real; ++i) {
+            double v2 = 0.0;
+            for (int c = 0; c < dim(); ++c) v2 += nodes.velocity[c][i] * nodes.velocity[c][i];
+            if (!(v2 <= top)) {
+                top = v2;
+                fastest = i;
+                if (std::isnan(v2)) break;
+            }
+        }
+        FailureSite site{steps, time, "totals", fastest, {}, {0, 0, 0}, dim(), "total energy", {}};
+        if (real > 0) {
+            const auto b = static_cast<std::size_t>(nodes.body[fastest]);
+            if (b < scene.bodies.size()) site.body = scene.bodies[b].name;
+            for (int c = 0; c < dim(); ++c) site.position[c] = nodes.position[c][fastest];
+        } else {
+            site.node.reset();
+        }
+        site.cause = fmt::format("the energy error {:+.3g} % exceeds stop.energy_error = {:.3g} % (kinetic {:.6g} J + "
+                                 "internal {:.6g} J + boundary work {:.6g} J against {:.6g} J at t = 0): the run is "
+                                 "unstable (a smaller solver.cfl may help); node {} is the fastest, at {:.4g} m/s",
+                                 100.0 * totals.energy_error, 100.0 * limit, totals.kinetic_energy, totals.internal_energy,
+                                 totals.boundary_work, totals.initial_energy, fastest, std::sqrt(std::max(top, 0.0)));
+        throw StepFailure(describe_site(site), site);
+    }
+}
+
+namespace {
+
+constexpr char checkpoint_magic[8] = {'G', 'P', 'A', 'C', 'H', 'K', 'P', 'T'};
+constexpr std::uint32_t byte_order_mark = 0x01020304u;
+
+void write_plan(StateWriter& out, const ScatterPlan& plan) {
+    out.value<std::int32_t>(static_cast<std::int32_t>(plan.scheme));
+    out.array(plan.colour_offsets);
+    out.array(plan.group_offsets);
+    out.array(plan.centres);
+}
+
+void read_plan(StateReader& in, ScatterPlan& plan, std::size_t node_count) {
+    plan.scheme = static_cast<ScatterScheme>(in.value<std::int32_t>());
+    in.array(plan.colour_offsets);
+    in.array(plan.group_offsets);
+    in.array(plan.centres);
+    const bool fits = !plan.colour_offsets.empty() && !plan.group_offsets.empty() &&
+                      plan.colour_offsets.back() <= plan.group_offsets.size() - 1 &&
+                      plan.group_offsets.back() <= plan.centres.size();
+    if (!fits) in.fail("its scatter plan is damaged");
+    for (const NodeIndex c : plan.centres) {
+        if (c >= node_count) in.fail("its scatter plan names a node that does not exist");
+    }
+}
+
+// The header: everything up to the state, read again by checkpoint_info.
+CheckpointInfo read_header(StateReader& in) {
+    char magic[8];
+    in.bytes(magic, sizeof magic);
+    if (!std::equal(magic, magic + 8, checkpoint_magic)) in.fail("it is not a gpa checkpoint");
+    CheckpointInfo info;
+    info.format = in.value<std::uint32_t>();
+    if (info.format != Simulation::checkpoint_format) {
+        in.fail(fmt::format("it is of format {}, this build reads format {}", info.format, Simulation::checkpoint_format));
+    }
+    if (in.value<std::uint32_t>() != byte_order_mark) in.fail("it was written on a machine of another byte order");
+    info.build = in.text();
+    info.scene_fingerprint = in.text();
+    info.scene_name = in.text();
+    info.step = static_cast<std::size_t>(in.value<std::uint64_t>());
+    info.time = in.value<double>();
+    info.user_data = in.text();
+    return info;
+}
+
+}  // namespace
+
+void Simulation::Impl::write_state(StateWriter& out) const {
+    out.tag("SIMU");
+    nodes.write_state(out);
+    out.value<std::uint64_t>(real);
+    ghosts.write_state(out);
+    out.tag("LIST");
+    write_rows(out, lists);
+    out.value<std::uint8_t>(search_due);
+    out.value<std::uint8_t>(plan_due);
+    out.value<double>(skin);
+    out.value<std::uint64_t>(searches);
+    write_rows(out, candidates);
+    out.array(lattice_entries);
+    for (int c = 0; c < dim(); ++c) out.array(searched_position[c]);
+    out.array(searched_diameter);
+    write_plan(out, plan);
+    out.array(bond_power);
+    out.array(largest_bond_q);
+    out.tag("TIME");
+    out.value<double>(time);
+    out.value<double>(dt_half);
+    out.value<double>(dt_next);
+    out.value<std::uint64_t>(steps);
+    out.value<double>(node_steps);
+    out.value<double>(kinetic_half);
+    out.value<double>(boundary_work);
+    out.value<double>(hourglass_work);
+    out.array(impulse);
+    out.array(reaction);
+    out.tag("TOTL");
+    const Totals& t = totals;
+    for (const double v : {t.time, t.time_step, t.kinetic_energy, t.internal_energy, t.plastic_work, t.viscous_work,
+                           t.boundary_work, t.initial_kinetic_energy, t.initial_energy, t.energy_error, t.momentum[0],
+                           t.momentum[1], t.momentum[2], t.length, t.footprint_diameter, t.hourglass_work}) {
+        out.value<double>(v);
+    }
+    for (const std::size_t v : {t.step, t.real_nodes, t.ghost_nodes, t.variable_nodes, t.failed_nodes, t.pairs,
+                                t.neighbour_searches}) {
+        out.value<std::uint64_t>(v);
+    }
+    out.value<std::uint64_t>(t.planes.size());
+    for (const auto& p : t.planes) {
+        out.text(p.name);
+        out.value<double>(p.reaction);
+        out.value<double>(p.impulse);
+    }
+    const auto times = graph->times();
+    out.value<std::uint64_t>(times.size());
+    for (const auto& p : times) {
+        out.text(p.name);
+        out.value<double>(p.seconds);
+        out.value<std::uint64_t>(p.calls);
+    }
+    out.tag("END.");
+}
+
+void Simulation::Impl::read_state(StateReader& in) {
+    in.tag("SIMU");
+    nodes.read_state(in);
+    if (in.value<std::uint64_t>() != real) in.fail("its bodies hold another number of nodes than the scene's");
+    const std::size_t n = nodes.size();
+    if (n < real) in.fail("it holds fewer nodes than the scene's bodies (a damaged checkpoint)");
+    ghosts.read_state(in, real, n);
+    in.tag("LIST");
+    read_rows(in, lists, std::numeric_limits<std::size_t>::max(), n);
+    search_due = in.value<std::uint8_t>() != 0;
+    plan_due = in.value<std::uint8_t>() != 0;
+    skin = in.value<double>();
+    searches = static_cast<std::size_t>(in.value<std::uint64_t>());
+    read_rows(in, candidates, std::numeric_limits<std::size_t>::max(), n);
+    in.array(lattice_entries);
+    for (int c = 0; c < dim(); ++c) in.array(searched_position[c]);
+    in.array(searched_diameter);
+    read_plan(in, plan, n);
+    in.array(bond_power);
+    in.array(largest_bond_q);
+    in.tag("TIME");
+    time = in.value<double>();
+    dt_half = in.value<double>();
+    dt_next = in.value<double>();
+    steps = static_cast<std::size_t>(in.value<std::uint64_t>());
+    node_steps = in.value<double>();
+    kinetic_half = in.value<double>();
+    boundary_work = in.value<double>();
+    hourglass_work = in.value<double>();
+    in.array(impulse);
+    in.array(reaction);
+    if (impulse.size() != rigid_planes.size() || reaction.size() != rigid_planes.size()) in.fail("its planes are not the scene's");
+    in.tag("TOTL");
+    Totals& t = totals;
+    for (double* v : {&t.time, &t.time_step, &t.kinetic_energy, &t.internal_energy, &t.plastic_work, &t.viscous_work,
+                      &t.boundary_work, &t.initial_kinetic_energy, &t.initial_energy, &t.energy_error, &t.momentum[0],
+                      &t.momentum[1], &t.momentum[2], &t.length, &t.footprint_diameter, &t.hourglass_work}) {
+        *v = in.value<double>();
+    }
+    for (std::size_t* v : {&t.step, &t.real_nodes, &t.ghost_nodes, &t.variable_nodes, &t.failed_nodes, &t.pairs,
+                           &t.neighbour_searches}) {
+        *v = static_cast<std::size_t>(in.value<std::uint64_t>());
+    }
+    const auto planes = in.value<std::uint64_t>();
+    if (planes != rigid_planes.size()) in.fail("its planes are not the scene's");
+    t.planes.resize(static_cast<std::size_t>(planes));
+    for (auto& p : t.planes) {
+        p.name = in.text();
+        p.reaction = in.value<double>();
+        p.impulse = in.value<double>();
+    }
+    const auto phase_count = in.value<std::uint64_t>();
+    if (phase_count > 1000) in.fail("its phase list is damaged");
+    std::vector<PhaseTime> times(static_cast<std::size_t>(phase_count));
+    for (auto& p : times) {
+        p.name = in.text();
+        p.seconds = in.value<double>();
+        p.calls = static_cast<std::size_t>(in.value<std::uint64_t>());
+    }
+    graph->restore_times(times);
+    in.tag("END.");
+    regroup_materials();
+}
+
+void Simulation::save_checkpoint(std::ostream& out, std::string_view scene_fingerprint, std::string_view user_data) const {
+    if (impl_->failed) throw NumericalError("Simulation::save_checkpoint: the last step failed and left the state half-updated");
+    StateWriter w(out);
+    w.bytes(checkpoint_magic, sizeof checkpoint_magic);
+    w.value<std::uint32_t>(checkpoint_format);
+    w.value<std::uint32_t>(byte_order_mark);
+    w.text(build_id());
+    w.text(scene_fingerprint);
+    w.text(impl_->scene.name);
+    w.value<std::uint64_t>(impl_->steps);
+    w.value<double>(impl_->time);
+    w.text(user_data);
+    impl_->write_state(w);
+    const std::uint64_t sum = w.checksum();
+    out.write(reinterpret_cast<const char*>(&sum), sizeof sum);
+}
+
+CheckpointInfo Simulation::checkpoint_info(std::istream& in, std::uint64_t size, const std::string& source) {
+    StateReader r(in, size, source);
+    return read_header(r);
+}
+
+std::string Simulation::restore_checkpoint(std::istream& in, std::uint64_t size, const std::string& source,
+                                           std::string_view scene_fingerprint) {
+    if (size < sizeof(std::uint64_t)) throw CheckpointError("checkpoint " + source + ": it is too short to be one");
+    StateReader r(in, size - sizeof(std::uint64_t), source);
+    const CheckpointInfo info = read_header(r);
+    if (info.build != build_id()) {
+        r.fail(fmt::format("it was written by {}, and this is {}: a run resumes bit-identically only with the build "
+                           "that started it",
+                           info.build, build_id()));
+    }
+    if (info.scene_fingerprint != scene_fingerprint) {
+        r.fail(fmt::format("it was written for another scene (scene \"{}\", fingerprint {}; this scene's is {})",
+                           info.scene_name, info.scene_fingerprint, scene_fingerprint));
+    }
+    impl_->failed = true;  // until the whole state has been read and checked
+    impl_->read_state(r);
+    if (r.left() != 0) r.fail("it holds more than a checkpoint of this scene (a damaged checkpoint)");
+    const std::uint64_t computed = r.checksum();
+    std::uint64_t stored = 0;
+    in.read(reinterpret_cast<char*>(&stored), sizeof stored);
+    if (!in || stored != computed) r.fail("its checksum does not match (a damaged checkpoint)");
+    impl_->failed = false;
+    return info.user_data;
+}
+
 }  // namespace gpa
+

@@ -7,18 +7,31 @@
 #include <fstream>
 #include <system_error>
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <fmt/format.h>
 
 namespace gpa::io {
 
 namespace fs = std::filesystem;
 
-RunFolder::RunFolder(fs::path folder, bool overwrite) : final_(std::move(folder)), overwrite_(overwrite) {
+RunFolder::RunFolder(fs::path folder, bool overwrite, Mode mode) : final_(std::move(folder)), overwrite_(overwrite) {
     if (final_.empty()) throw OutputError("the output folder name is empty");
     if (final_.filename().empty()) final_ = final_.parent_path();  // "out/" -> "out"
+    if (mode == Mode::Resume && final_.extension() == ".partial") final_.replace_extension();
     partial_ = final_;
     partial_ += ".partial";
+    lock_.emplace(final_);
     std::error_code ec;
+    if (mode == Mode::Resume) {
+        if (!fs::is_directory(partial_, ec)) {
+            throw OutputError(fmt::format("there is no stopped run to resume in '{}': '{}' does not exist{}", final_.string(),
+                                          partial_.string(),
+                                          fs::is_directory(final_, ec) ? " (the run in it has finished)" : ""));
+        }
+        return;
+    }
     if (fs::exists(final_, ec)) {
         if (!fs::is_directory(final_, ec)) {
             throw OutputError(fmt::format("output '{}' exists and is not a folder", final_.string()));
@@ -49,10 +62,9 @@ void RunFolder::commit() {
     if (ec) throw OutputError(fmt::format("cannot rename '{}' to '{}': {}", partial_.string(), final_.string(), ec.message()));
 }
 
-HistoryWriter::HistoryWriter(const fs::path& file, const Totals& first, int dim)
-    : path_(file), dim_(dim), planes_(first.planes.size()) {
-    file_ = std::fopen(file.string().c_str(), "w");
-    if (!file_) throw OutputError(fmt::format("cannot write '{}': {}", file.string(), std::strerror(errno)));
+namespace {
+
+std::string history_header(const Totals& first, int dim) {
     std::string header =
         "time_s,dt_s,step,kinetic_energy_J,internal_energy_J,plastic_work_J,viscous_work_J,boundary_work_J,"
         "total_energy_error,hourglass_work_J";
@@ -60,11 +72,61 @@ HistoryWriter::HistoryWriter(const fs::path& file, const Totals& first, int dim)
     header += ",length_m,footprint_diameter_m";
     for (const auto& p : first.planes) header += fmt::format(",{0}_reaction_N,{0}_impulse_N_s", p.name.empty() ? "plane" : p.name);
     header += ",real_nodes,ghost_nodes,variable_nodes,failed_nodes,neighbour_pairs\n";
-    std::fputs(header.c_str(), file_);
+    return header;
+}
+
+}  // namespace
+
+HistoryWriter::HistoryWriter(const fs::path& file, const Totals& first, int dim)
+    : path_(file), dim_(dim), planes_(first.planes.size()) {
+    fd_ = ::open(file.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    if (fd_ < 0) throw OutputError(fmt::format("cannot write '{}': {}", file.string(), std::strerror(errno)));
+    append(history_header(first, dim));
+}
+
+HistoryWriter::HistoryWriter(const fs::path& file, const Totals& first, int dim, const std::function<bool(std::size_t)>& keep)
+    : path_(file), dim_(dim), planes_(first.planes.size()) {
+    std::ifstream in(file, std::ios::binary);
+    if (!in) throw OutputError(fmt::format("cannot read '{}' of the stopped run", file.string()));
+    const std::string header = history_header(first, dim);
+    std::string line, text;
+    if (!std::getline(in, line) || line + "\n" != header) {
+        throw OutputError(fmt::format("'{}' does not start with the header this run writes", file.string()));
+    }
+    text = header;
+    while (std::getline(in, line)) {
+        if (in.eof()) break;  // a last line without its end: not a whole row
+        const auto first_comma = line.find(','), second_comma = line.find(',', first_comma + 1);
+        if (first_comma == std::string::npos || second_comma == std::string::npos) continue;
+        const std::string step = line.substr(second_comma + 1, line.find(',', second_comma + 1) - second_comma - 1);
+        if (step.empty() || step.find_first_not_of("0123456789") != std::string::npos) continue;
+        if (keep(static_cast<std::size_t>(std::stoull(step)))) text += line + "\n";
+    }
+    write_text_file(file, text);
+    fd_ = ::open(file.c_str(), O_WRONLY | O_APPEND | O_CLOEXEC);
+    if (fd_ < 0) throw OutputError(fmt::format("cannot write '{}': {}", file.string(), std::strerror(errno)));
+    size_ = static_cast<long long>(text.size());
 }
 
 HistoryWriter::~HistoryWriter() {
-    if (file_) std::fclose(file_);
+    if (fd_ >= 0) ::close(fd_);
+}
+
+void HistoryWriter::append(const std::string& text) {
+    std::size_t done = 0;
+    while (done < text.size()) {
+        const ssize_t n = ::write(fd_, text.data() + done, text.size() - done);
+        if (n < 0 && errno == EINTR) continue;
+        if (n <= 0) {
+            const int error = n < 0 ? errno : ENOSPC;
+            // Cut back to the whole lines before this one.
+            const bool cut = ::ftruncate(fd_, static_cast<off_t>(size_)) == 0;
+            throw OutputError(fmt::format("writing '{}' failed: {}{}", path_.string(), std::strerror(error),
+                                          cut ? "" : " (and the incomplete row could not be removed)"));
+        }
+        done += static_cast<std::size_t>(n);
+    }
+    size_ += static_cast<long long>(text.size());
 }
 
 void HistoryWriter::write(const Totals& t) {
@@ -78,19 +140,33 @@ void HistoryWriter::write(const Totals& t) {
         row += fmt::format(",{:.9e},{:.9e}", r.reaction, r.impulse);
     }
     row += fmt::format(",{},{},{},{},{}\n", t.real_nodes, t.ghost_nodes, t.variable_nodes, t.failed_nodes, t.pairs);
-    if (std::fputs(row.c_str(), file_) < 0 || std::fflush(file_) != 0) {
-        throw OutputError(fmt::format("writing '{}' failed: {}", path_.string(), std::strerror(errno)));
-    }
+    append(row);
 }
 
 SnapshotSeries::SnapshotSeries(fs::path folder, std::string stem) : folder_(std::move(folder)), stem_(std::move(stem)) {}
 
 std::string SnapshotSeries::write(const NodeStore& nodes, std::size_t count, double time) {
-    const std::string name = fmt::format("{}_{:05d}.vtp", stem_, entries_.size());
+    const std::string name = fmt::format("{}_{:05d}.vtp", stem_, scheduled_);
     write_vtp(folder_ / name, nodes, count);
     entries_.push_back({time, name});
+    ++scheduled_;
     write_pvd(folder_ / (stem_ + ".pvd"), entries_);
     return name;
+}
+
+std::string SnapshotSeries::write_marked(const NodeStore& nodes, std::size_t count, double time, const std::string& label,
+                                         const std::string& mark) {
+    const std::string name = fmt::format("{}_{}.vtp", stem_, label);
+    write_vtp(folder_ / name, nodes, count);
+    entries_.push_back({time, name, mark});
+    write_pvd(folder_ / (stem_ + ".pvd"), entries_);
+    return name;
+}
+
+void SnapshotSeries::restore(std::vector<PvdEntry> entries, std::size_t scheduled) {
+    entries_ = std::move(entries);
+    scheduled_ = scheduled;
+    write_pvd(folder_ / (stem_ + ".pvd"), entries_);
 }
 
 namespace {
@@ -144,6 +220,7 @@ void write_summary(const fs::path& file, const Simulation& sim, const RunSummary
     field("geometry", json_string(std::string(name_of(scene.geometry))));
     field("status", json_string(run.status));
     field("message", json_string(run.message));
+    if (!run.failure_json.empty()) field("failure", run.failure_json);
     field("time_s", json_number(t.time));
     field("steps", std::to_string(t.step));
     field("real_nodes", std::to_string(t.real_nodes));
@@ -220,20 +297,19 @@ void write_profile(const fs::path& file, const Simulation& sim) {
         top = std::max(top, plane->side * (n.position[plane->axis][i] - plane->position) + 0.5 * n.diameter[i]);
     }
     const double bin = mean_d;  // one row of nodes: narrower bins hold only inner nodes every other time
-    const std::size_t bins = static_cast<std::size_t>(std::ceil(top / bin)) + 1;
-    std::vector<double> radius(bins, -1.0);
+    // Only the bins that hold nodes, at most one per node, however far apart the bodies are.
+    std::map<double, double> radius;  // bin index (a whole number) -> largest extent
     for (std::size_t i = 0; i < count; ++i) {
         const double h = plane->side * (n.position[plane->axis][i] - plane->position);
         double r = 0.0;
         for (int c : across) r += (n.position[c][i] - centre[c]) * (n.position[c][i] - centre[c]);
         r = std::sqrt(r);
-        const auto k = static_cast<std::size_t>(std::clamp(h / bin, 0.0, double(bins - 1)));
-        radius[k] = std::max(radius[k], r + 0.5 * n.diameter[i]);
+        const double k = std::floor(std::max(h / bin, 0.0));
+        const auto [it, added] = radius.try_emplace(k, r + 0.5 * n.diameter[i]);
+        if (!added) it->second = std::max(it->second, r + 0.5 * n.diameter[i]);
     }
     std::string text = "height_m,radius_m\n";
-    for (std::size_t k = 0; k < bins; ++k) {
-        if (radius[k] >= 0.0) text += fmt::format("{:.6e},{:.6e}\n", (double(k) + 0.5) * bin, radius[k]);
-    }
+    for (const auto& [k, r] : radius) text += fmt::format("{:.6e},{:.6e}\n", (k + 0.5) * bin, r);
     text += fmt::format("{:.6e},{:.6e}\n", top, 0.0);
     write_text_file(file, text);
 }

@@ -38,8 +38,8 @@ const std::vector<std::string_view> solver_keys{
     "cfl",          "alpha_limit",           "max_time_step",      "time_step_growth", "failure",
     "scatter",      "reorder_interval",      "neighbour_skin",
 };
-const std::vector<std::string_view> stop_keys{"end_time", "kinetic_energy_fraction", "max_steps"};
-const std::vector<std::string_view> output_keys{"snapshots", "snapshot_interval", "history_every"};
+const std::vector<std::string_view> stop_keys{"end_time", "kinetic_energy_fraction", "max_steps", "energy_error"};
+const std::vector<std::string_view> output_keys{"snapshots", "snapshot_interval", "history_every", "checkpoint_every"};
 
 const Choices<ConnectivityMode> connectivity_words{
     {"fixed", ConnectivityMode::Fixed}, {"variable", ConnectivityMode::Variable}, {"automatic", ConnectivityMode::Automatic}};
@@ -343,6 +343,7 @@ StopCriteria read_stop(const Reporter& reporter, const toml::table& table) {
     if (const auto v = r.whole_number("max_steps", 0, std::numeric_limits<long long>::max())) {
         s.max_steps = static_cast<std::size_t>(*v);
     }
+    if (const auto v = r.quantity("energy_error", D::Dimensionless, Limit::NonNegative)) s.energy_error = *v;
     return s;
 }
 
@@ -355,6 +356,16 @@ OutputOptions read_output(const Reporter& reporter, const toml::table& table) {
     if (const auto v = r.quantity("snapshot_interval", D::Time, Limit::NonNegative)) o.snapshot_interval = *v;
     if (const auto v = r.whole_number("history_every", 1, std::numeric_limits<long long>::max())) {
         o.history_every = static_cast<std::size_t>(*v);
+    }
+    // checkpoint_every: a whole number of steps, or a wall-clock time ("10 min").
+    if (const toml::node* every = r.find("checkpoint_every")) {
+        if (every->is_string()) {
+            o.checkpoint_every_seconds = r.required_quantity("checkpoint_every", D::Time, Limit::NonNegative);
+            o.checkpoint_every_steps = 0;
+        } else {
+            o.checkpoint_every_steps = static_cast<std::size_t>(*r.whole_number("checkpoint_every", 0, std::numeric_limits<long long>::max()));
+            o.checkpoint_every_seconds = 0.0;
+        }
     }
     return o;
 }
@@ -445,23 +456,30 @@ Scene parse_scene(std::string_view text, const std::string& file_name_for_messag
     return scene;
 }
 
-Scene load_scene(const std::filesystem::path& file) {
+std::string read_scene_text(const std::filesystem::path& file) {
     const std::string name = file.string();
     const Reporter reporter(name);
     std::error_code ec;
     const auto status = std::filesystem::status(file, ec);
     if (ec || !std::filesystem::exists(status)) reporter.fail(0, "", "cannot read the scene file: it does not exist");
     if (std::filesystem::is_directory(status)) reporter.fail(0, "", "cannot read the scene file: it is a directory");
-    const auto size = std::filesystem::file_size(file, ec);
-    if (!ec && size > max_scene_file_bytes) {
-        reporter.fail(0, "", fmt::format("is {} bytes long: too large for a scene file (at most {})", size, max_scene_file_bytes));
-    }
     std::ifstream in(file, std::ios::binary);
     if (!in) reporter.fail(0, "", "cannot open the scene file for reading");
-    std::ostringstream text;
-    text << in.rdbuf();
+    // Read in pieces up to one byte past the limit, whatever the file is (a device such as
+    // /dev/zero, a pipe or a file still growing reports no size, or a wrong one).
+    std::string text;
+    char buffer[1 << 16];
+    while (in) {
+        in.read(buffer, sizeof buffer);
+        text.append(buffer, static_cast<std::size_t>(in.gcount()));
+        if (text.size() > max_scene_file_bytes) {
+            reporter.fail(0, "", fmt::format("is longer than {} bytes: too large for a scene file", max_scene_file_bytes));
+        }
+    }
     if (in.bad()) reporter.fail(0, "", "reading the scene file failed");
-    return parse_scene(text.str(), name);
+    return text;
 }
+
+Scene load_scene(const std::filesystem::path& file) { return parse_scene(read_scene_text(file), file.string()); }
 
 }  // namespace gpa::io

@@ -169,6 +169,103 @@ void check_text(std::string_view text, const Reporter& reporter) {
         }
         i += continuation + 1;
     }
+    check_non_ascii_placement(text, reporter);
+}
+
+void check_non_ascii_placement(std::string_view text, const Reporter& reporter) {
+    // toml++ 3.3.0 tests characters outside strings and comments against Unicode tables that,
+    // for many code points (U+00A1-U+0499 among them: the bytes CF BB are U+03FB), reach
+    // __builtin_unreachable: undefined behaviour before it can report a syntax error. TOML 1.0
+    // allows non-ASCII characters only in strings and comments, so one anywhere else is an error
+    // anyway, reported here before toml++ sees it. toml++ reaches the same tables for the
+    // character after a backslash in a multi-line basic string and for the first character
+    // after the line break that a line-ending backslash skips; a non-ASCII character there is
+    // refused too (an escape such as \u03FB says the same).
+    enum class In { Nothing, Comment, Basic, Literal, MultiBasic, MultiLiteral };
+    In in = In::Nothing;
+    std::size_t line = 1;
+    const std::size_t n = text.size();
+    const auto at = [&](std::size_t k) { return k < n ? static_cast<unsigned char>(text[k]) : 0u; };
+    const auto run_of = [&](std::size_t k, unsigned char quote) {
+        std::size_t r = 0;
+        while (at(k + r) == quote) ++r;
+        return r;
+    };
+    std::size_t i = text.substr(0, 3) == "\xEF\xBB\xBF" ? 3 : 0;  // a byte-order mark
+    while (i < n) {
+        const unsigned char c = at(i);
+        if (c == '\n') ++line;
+        switch (in) {
+            case In::Nothing:
+                if (c == '#') {
+                    in = In::Comment;
+                } else if (c == '"' || c == '\'') {
+                    const bool multi = run_of(i, c) >= 3;
+                    in = c == '"' ? (multi ? In::MultiBasic : In::Basic) : (multi ? In::MultiLiteral : In::Literal);
+                    i += multi ? 3 : 1;
+                    continue;
+                } else if (c >= 0x80) {
+                    reporter.fail(line, "",
+                                  "a non-ASCII character outside a quoted string or a comment: TOML allows them only "
+                                  "there (keys with such characters must be quoted)");
+                }
+                break;
+            case In::Comment:
+                if (c == '\n') in = In::Nothing;
+                break;
+            case In::Literal:
+                if (c == '\'' || c == '\n') in = In::Nothing;
+                break;
+            case In::Basic:
+            case In::MultiBasic:
+                if (c == '\\') {
+                    std::size_t k = i + 1;
+                    if (in == In::MultiBasic) {
+                        while (at(k) == ' ' || at(k) == '\t') ++k;
+                        if (at(k) == '\n' || (at(k) == '\r' && at(k + 1) == '\n')) {
+                            // A line-ending backslash: toml++ skips the whitespace that follows.
+                            while (k < n && (at(k) == ' ' || at(k) == '\t' || at(k) == '\r' || at(k) == '\n')) {
+                                if (at(k) == '\n') ++line;
+                                ++k;
+                            }
+                            if (at(k) >= 0x80) {
+                                reporter.fail(line, "",
+                                              "a non-ASCII character right after the line break of a line-ending "
+                                              "backslash (toml++ 3.3 mishandles it): put an ASCII character or an "
+                                              "escape such as \\u00E9 first");
+                            }
+                            i = k;
+                            continue;
+                        }
+                        k = i + 1;
+                    }
+                    if (at(k) >= 0x80) {
+                        reporter.fail(line, "", "a backslash before a non-ASCII character: not an escape TOML knows");
+                    }
+                    if (at(k) == '\n') ++line;
+                    i = k + 1;
+                    continue;
+                }
+                if (in == In::Basic && (c == '"' || c == '\n')) {
+                    in = In::Nothing;
+                } else if (in == In::MultiBasic && c == '"') {
+                    const std::size_t r = run_of(i, '"');
+                    if (r >= 3) in = In::Nothing;
+                    i += r;
+                    continue;
+                }
+                break;
+            case In::MultiLiteral:
+                if (c == '\'') {
+                    const std::size_t r = run_of(i, '\'');
+                    if (r >= 3) in = In::Nothing;
+                    i += r;
+                    continue;
+                }
+                break;
+        }
+        ++i;
+    }
 }
 
 toml::table parse_toml(std::string_view text, const Reporter& reporter) {

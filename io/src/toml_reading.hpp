@@ -41,6 +41,10 @@ std::string in_quotes(std::string_view text);
 // control characters (binary data) and invalid UTF-8, naming the line.
 void check_text(std::string_view text, const Reporter& reporter);
 
+// Part of check_text: non-ASCII characters only inside strings and comments, as TOML 1.0 says
+// (toml++ 3.3.0 has undefined behaviour on some of them elsewhere; see the definition).
+void check_non_ascii_placement(std::string_view text, const Reporter& reporter);
+
 // Parses TOML text, turning syntax errors into "file:line:column: TOML syntax error: ...".
 toml::table parse_toml(std::string_view text, const Reporter& reporter);
 

@@ -35,6 +35,8 @@ constexpr std::array units{
     Unit{"ms", D::Time, -3},
     Unit{"us", D::Time, -6},
     Unit{"ns", D::Time, -9},
+    Unit{"min", D::Time, 0, 60.0},
+    Unit{"h", D::Time, 0, 3600.0},
 
     Unit{"m/s", D::Velocity, 0},
     Unit{"km/s", D::Velocity, 3},

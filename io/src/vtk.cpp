@@ -124,7 +124,12 @@ void write_pvd(const std::filesystem::path& path, const std::vector<PvdEntry>& e
     write_file_atomically(path, [&](std::ofstream& out) {
         out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"1.0\" byte_order=\"LittleEndian\">\n  <Collection>\n";
         for (const auto& e : entries) {
-            out << fmt::format("    <DataSet timestep=\"{:.9g}\" part=\"0\" file=\"{}\"/>\n", e.time, e.file);
+            if (e.name.empty()) {
+                out << fmt::format("    <DataSet timestep=\"{:.9g}\" part=\"0\" file=\"{}\"/>\n", e.time, e.file);
+            } else {
+                out << fmt::format("    <DataSet timestep=\"{:.9g}\" part=\"0\" file=\"{}\" name=\"{}\"/>\n", e.time, e.file,
+                                   e.name);
+            }
         }
         out << "  </Collection>\n</VTKFile>\n";
     });

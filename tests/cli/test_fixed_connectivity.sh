@@ -20,9 +20,9 @@ for spacing in 0.381 0.254 0.1905; do
     continue
   fi
   [[ $code -eq 3 ]] || fail "spacing $spacing mm: exit $code, expected 0 or 3: $(head -c 400 err.txt)"
-  grep -q 'body "bar", node [0-9]* at (x, z) = (' err.txt || fail "spacing $spacing mm: the message does not name the node: $(head -c 400 err.txt)"
+  grep -q 'node [0-9]* of body "bar" at (' err.txt || fail "spacing $spacing mm: the message does not name the node: $(head -c 400 err.txt)"
   grep -q 'connectivity = \\"automatic\\"\|connectivity = "automatic"' err.txt || fail "spacing $spacing mm: no remedy in: $(head -c 400 err.txt)"
-  grep -q 'step [0-9]*, t = ' err.txt || fail "spacing $spacing mm: no step and time in: $(head -c 400 err.txt)"
+  grep -q 'step [0-9]* at t = ' err.txt || fail "spacing $spacing mm: no step and time in: $(head -c 400 err.txt)"
   [[ -s "run-$spacing.partial/history.csv" && -s "run-$spacing.partial/summary.json" ]] || fail "spacing $spacing mm: output not kept"
   grep -q '"status": "failed"' "run-$spacing.partial/summary.json" || fail "spacing $spacing mm: summary does not say failed"
   echo "spacing $spacing mm: stopped cleanly: $(head -n 1 err.txt | cut -c 1-160)"

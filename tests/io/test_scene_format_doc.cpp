@@ -109,15 +109,19 @@ TEST(SceneFormatDoc, DefaultsAreThoseOfSceneHpp) {
     expect_number(doc, "end_time", stop.end_time);
     expect_number(doc, "kinetic_energy_fraction", stop.kinetic_energy_fraction);
     expect_number(doc, "max_steps", static_cast<double>(stop.max_steps));
+    expect_number(doc, "energy_error", stop.energy_error);
 
     const OutputOptions o;
     expect_number(doc, "snapshots", static_cast<double>(o.snapshots));
     expect_number(doc, "snapshot_interval", o.snapshot_interval);
     expect_number(doc, "history_every", static_cast<double>(o.history_every));
+    // checkpoint_every: a wall-clock time by default, documented with its unit.
+    EXPECT_EQ(o.checkpoint_every_steps, 0u);
+    expect_word(doc, "checkpoint_every", fmt::format("\"{:g} min\"", o.checkpoint_every_seconds / 60.0));
 
-    // 20 solver options, 3 stop criteria, 3 output options, and no row for an option that does
+    // 20 solver options, 4 stop criteria, 4 output options, and no row for an option that does
     // not exist.
-    EXPECT_EQ(doc.size(), 26u) << "rows in [solver], [stop] and [output] of docs/scene-format.md";
+    EXPECT_EQ(doc.size(), 28u) << "rows in [solver], [stop] and [output] of docs/scene-format.md";
 }
 
 }  // namespace

@@ -104,6 +104,11 @@ public:
     // the bodies away from the plane.
     std::vector<double> normal_reactions(const NodeStore& nodes, std::size_t real_count) const;
 
+    // Checkpoints: the ghosts of the last build and their lookup tables (the planes are the
+    // scene's and are not stored; read_state checks that they match).
+    void write_state(StateWriter& out) const;
+    void read_state(StateReader& in, std::size_t real_count, std::size_t node_count);
+
 private:
     std::vector<GhostPlane> planes_;
     std::vector<std::uint8_t> masks_;            // the corner combinations in use: distinct axes

@@ -7,6 +7,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "gpa/engine/compressed_rows.hpp"
@@ -40,6 +41,9 @@ bool needs_search(const NodeStore& nodes, std::size_t centres);
 // Reusable state of the search (the cell grid), kept between searches.
 struct NeighbourScratch {
     CellGrid grid;
+    // Called with the number of entries the lists will hold, after they are counted and before
+    // they are allocated; may throw (a memory limit, Simulation). Empty: no check.
+    std::function<void(std::size_t entries)> check_entries;
 };
 
 // The neighbour lists of centres [0, centres), drawn from all nodes [0, nodes.size()):

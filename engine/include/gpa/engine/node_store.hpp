@@ -16,6 +16,9 @@
 
 namespace gpa {
 
+class StateWriter;
+class StateReader;
+
 enum class Connectivity : std::uint8_t { Fixed = 0, Variable = 1 };
 
 class NodeStore {
@@ -33,6 +36,11 @@ public:
     // Reorders every per-node field so that new node k is old node new_to_old[k], and rewrites
     // the fixed neighbour lists in the new numbering. new_to_old must be a permutation.
     void permute(std::span<const NodeIndex> new_to_old);
+
+    // Checkpoints (Simulation::save_checkpoint): every field of every node and the fixed lists.
+    // read_state throws CheckpointError when the data is not that of a store of this geometry.
+    void write_state(StateWriter& out) const;
+    void read_state(StateReader& in);
 
     // --- state carried from step to step -------------------------------------------------
     std::array<std::vector<double>, 3> position;   // m

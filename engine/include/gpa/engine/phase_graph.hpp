@@ -28,7 +28,12 @@ public:
     void add(std::string name, std::function<void()> body);
     // Runs every phase once, in order; rethrows the first exception a phase throws.
     void run();
+    // The name of the phase whose exception the last run() rethrew; empty if it threw none.
+    std::string failed_phase() const;
     std::vector<PhaseTime> times() const;
+    // Sets the accumulated times of the phases named in `times` (a resumed run carries on the
+    // wall times of the run it continues).
+    void restore_times(const std::vector<PhaseTime>& times);
     std::vector<std::string> names() const;
 
 private:

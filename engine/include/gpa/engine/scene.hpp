@@ -132,12 +132,20 @@ struct StopCriteria {
     double end_time = 0.0;                 // s; 0 = no time limit
     double kinetic_energy_fraction = 0.0;  // stop when KE < fraction * initial KE; 0 = off
     std::size_t max_steps = 0;             // 0 = no limit
+    // The energy guard: a run whose energy error |KE + IE + boundary work - E0| / E0 exceeds this
+    // stops as a numerical failure (an unstable run). The scenes of scenes/ end at 0.1-0.6 % at
+    // the default C_cfl (docs/cfl-range.md); a sphere through a plate was reported at 1.8 % (issue 14). 0 = no guard.
+    double energy_error = 0.03;
 };
 
 struct OutputOptions {
     std::size_t snapshots = 20;      // ParaView snapshots over the run, first and last included (0 or 1: those two only)
     double snapshot_interval = 0.0;  // s; > 0 overrides `snapshots`
     std::size_t history_every = 10;  // steps between history rows (the last step is always written)
+    // Checkpoints of a run (gpa run --resume): every this many steps, or every this much wall-clock
+    // time (s); 0 = never (a run still writes one when it is interrupted).
+    std::size_t checkpoint_every_steps = 0;
+    double checkpoint_every_seconds = 600.0;
 };
 
 struct Scene {

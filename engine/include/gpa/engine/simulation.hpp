@@ -19,11 +19,16 @@
 // half steps around it.
 
 #include <cstddef>
+#include <cstdint>
+#include <istream>
 #include <memory>
+#include <ostream>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "gpa/engine/compressed_rows.hpp"
+#include "gpa/engine/limits.hpp"
 #include "gpa/engine/node_store.hpp"
 #include "gpa/engine/phase_graph.hpp"
 #include "gpa/engine/scene.hpp"
@@ -62,15 +67,32 @@ struct Totals {
     std::string first_collapse_switch;
 };
 
+// What a checkpoint file says about itself (Simulation::checkpoint_info).
+struct CheckpointInfo {
+    std::uint32_t format = 0;
+    std::string build;              // build_id() of the program that wrote it
+    std::string scene_fingerprint;  // as given to save_checkpoint
+    std::string scene_name;
+    std::size_t step = 0;
+    double time = 0.0;
+    std::string user_data;
+};
+
 class Simulation {
 public:
     // Builds the nodes of every body and the phase graph. threads = 0 uses all hardware threads.
-    // Throws InputError for an impossible scene.
-    explicit Simulation(Scene scene, int threads = 0);
+    // Throws InputError for an impossible scene, LimitError when its nodes would not fit in the
+    // memory limit (checked before they are made; the neighbour lists are checked against it
+    // before every search allocates them).
+    explicit Simulation(Scene scene, int threads = 0, MemoryLimit memory = {});
     ~Simulation();
     Simulation(const Simulation&) = delete;
     Simulation& operator=(const Simulation&) = delete;
 
+    // Advances one step. A failing step throws StepFailure (step, time, phase, node, body,
+    // position, field and cause in one line), and so does a step after which the energy error
+    // exceeds stop.energy_error (the energy guard) or the time no longer advances; after a
+    // failure no further step runs.
     void step();
     // True when a stop criterion of the scene is met; stop_reason() says which.
     bool finished() const;
@@ -93,6 +115,26 @@ public:
     // The neighbour lists of the last step: rows [0, real_count()) of the real nodes, then the
     // rows of the ghosts (indices >= real_count() are ghosts).
     const CompressedRows& neighbour_lists() const;
+
+    // --- checkpoints --------------------------------------------------------------------------
+    // Writes everything later steps depend on (every node field, the ghosts, the neighbour lists
+    // and their candidates with the positions and diameters of the last search, the scatter
+    // plan, both time steps, the half-step kinetic energy, impulses, boundary work, counters,
+    // totals and phase times), so that a Simulation built from the same scene and restored from
+    // it continues bit-identically to one never stopped, on any thread count. The file is
+    // versioned and carries build_id(), `scene_fingerprint` (what identifies the scene to the
+    // caller, e.g. a hash of its file) and `user_data` (anything the caller wants back).
+    void save_checkpoint(std::ostream& out, std::string_view scene_fingerprint, std::string_view user_data = {}) const;
+    // Restores a checkpoint of `size` bytes (`source` names it in messages) into a Simulation
+    // built from the same scene; returns its user_data. Throws CheckpointError, before changing
+    // anything, when the format, the build or the scene fingerprint differ; for a damaged file
+    // (it throws too) the Simulation is left unusable.
+    std::string restore_checkpoint(std::istream& in, std::uint64_t size, const std::string& source,
+                                   std::string_view scene_fingerprint);
+    // Reads the header of a checkpoint (no Simulation needed). Throws CheckpointError.
+    static CheckpointInfo checkpoint_info(std::istream& in, std::uint64_t size, const std::string& source);
+    // The format version save_checkpoint writes.
+    static constexpr std::uint32_t checkpoint_format = 1;
 
 private:
     struct Impl;

@@ -5,44 +5,64 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "gpa/engine/simulation.hpp"
 #include "gpa/io/atomic_file.hpp"
+#include "gpa/io/folder_lock.hpp"
 #include "gpa/io/vtk.hpp"
 
 namespace gpa::io {
 
 class RunFolder {
 public:
-    // Refuses an existing, non-empty `folder` unless overwrite is set (OutputError naming it);
-    // clears a stale `folder.partial` left by an earlier failed run and creates a fresh one.
-    RunFolder(std::filesystem::path folder, bool overwrite);
+    // Fresh: refuses an existing, non-empty `folder` unless overwrite is set (OutputError naming
+    // it); clears a stale `folder.partial` left by an earlier failed run and creates a fresh one.
+    // Resume: `folder` (or `folder.partial`) names a run that was stopped; its folder.partial
+    // must exist and is kept as it is.
+    // Either way the folder's lock (folder.lock, FolderLock) is taken first and held until the
+    // RunFolder is destroyed: a second run on the same folder is refused before it touches it.
+    enum class Mode { Fresh, Resume };
+    RunFolder(std::filesystem::path folder, bool overwrite, Mode mode = Mode::Fresh);
     const std::filesystem::path& partial() const { return partial_; }
     const std::filesystem::path& final_path() const { return final_; }
     // Renames folder.partial to folder (replacing an old folder only now, when overwriting).
     void commit();
+    // Whether commit() may replace an existing folder (a resumed run takes it from its checkpoint).
+    void set_overwrite(bool overwrite) { overwrite_ = overwrite; }
 
 private:
     std::filesystem::path final_, partial_;
     bool overwrite_;
+    std::optional<FolderLock> lock_;
 };
 
-// history.csv: one row per call, with a header naming every column and its unit.
+// history.csv: one row per call, with a header naming every column and its unit. Every row
+// goes to the file whole or not at all: a write that fails (disk full) is cut back to the rows
+// before it and reported as OutputError, so the file always ends with a complete line.
 class HistoryWriter {
 public:
     HistoryWriter(const std::filesystem::path& file, const Totals& first, int dim);
+    // For a resumed run: keeps the header and the rows whose step `keep` accepts (the file is
+    // rewritten atomically) and appends after them. OutputError when the file is missing or its
+    // header is not the one this run writes.
+    HistoryWriter(const std::filesystem::path& file, const Totals& first, int dim,
+                  const std::function<bool(std::size_t step)>& keep);
     ~HistoryWriter();
     HistoryWriter(const HistoryWriter&) = delete;
     HistoryWriter& operator=(const HistoryWriter&) = delete;
     void write(const Totals& t);
 
 private:
-    std::FILE* file_ = nullptr;
+    void append(const std::string& text);
+    int fd_ = -1;
+    long long size_ = 0;  // bytes of whole lines in the file
     std::filesystem::path path_;
     int dim_;
     std::size_t planes_;
@@ -53,21 +73,33 @@ private:
 class SnapshotSeries {
 public:
     explicit SnapshotSeries(std::filesystem::path folder, std::string stem = "particles");
-    // Writes nodes [0, count) at time t; returns the file name.
+    // Writes nodes [0, count) at time t as the next scheduled snapshot (particles_NNNNN.vtp);
+    // returns the file name.
     std::string write(const NodeStore& nodes, std::size_t count, double time);
+    // Writes a snapshot outside the schedule, named <stem>_<label>.vtp and marked `mark` in the
+    // .pvd (e.g. label "failed_step00027", mark "failed step 27").
+    std::string write_marked(const NodeStore& nodes, std::size_t count, double time, const std::string& label,
+                             const std::string& mark);
     std::size_t count() const { return entries_.size(); }
+    std::size_t scheduled() const { return scheduled_; }
+    const std::vector<PvdEntry>& entries() const { return entries_; }
+    // A resumed run carries on a series: its entries so far, `scheduled` of them on the schedule
+    // (the .pvd is rewritten to list exactly these).
+    void restore(std::vector<PvdEntry> entries, std::size_t scheduled);
 
 private:
     std::filesystem::path folder_;
     std::string stem_;
     std::vector<PvdEntry> entries_;
+    std::size_t scheduled_ = 0;
 };
 
 // The summary of a finished (or failed) run.
 struct RunSummary {
     std::string scene_file;
-    std::string status = "finished";  // "finished" or "failed"
+    std::string status = "finished";  // "finished", "failed" or "interrupted"
     std::string message;              // the stop reason, or the error
+    std::string failure_json;         // a failed step: {"step": ..., "phase": ..., ...} (a JSON object), or empty
     double wall_seconds = 0.0;
     double output_seconds = 0.0;
     std::size_t snapshots = 0;

@@ -25,6 +25,10 @@ public:
 // the file cannot be read).
 Scene load_scene(const std::filesystem::path& file);
 
+// The bytes of a scene file, read with the scene-size limit (16 MiB) whatever the file is: a
+// device or a pipe that never ends is refused once it passes the limit. Throws SceneError.
+std::string read_scene_text(const std::filesystem::path& file);
+
 // Parses scene text; `file_name_for_messages` is what messages call the file.
 Scene parse_scene(std::string_view text, const std::string& file_name_for_messages);
 

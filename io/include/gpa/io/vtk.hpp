@@ -21,6 +21,7 @@ void write_vtp(const std::filesystem::path& path, const NodeStore& nodes, std::s
 struct PvdEntry {
     double time;
     std::string file;  // relative to the .pvd
+    std::string name = {};  // a mark such as "failed step 27" (the DataSet's name attribute); empty: none
 };
 void write_pvd(const std::filesystem::path& path, const std::vector<PvdEntry>& entries);
 

@@ -1,0 +1,143 @@
+#pragma once
+// The binary encoding of checkpoints (Simulation::save_checkpoint): values and arrays as their
+// bytes in this machine's order, each array after its length, sections marked by four-letter
+// tags, and a running FNV-1a checksum of everything written. The reader checks every length
+// against the bytes left in the file before it allocates, every tag, and the checksum, so that
+// a damaged or foreign file is refused with a message and never read past its end.
+
+#include <cstddef>
+#include <cstdint>
+#include <istream>
+#include <ostream>
+#include <string>
+#include <string_view>
+#include <type_traits>
+#include <vector>
+
+#include "gpa/engine/errors.hpp"
+
+namespace gpa {
+
+// A checkpoint that cannot be used: damaged, of another format version, written by another
+// build or for another scene. what() is one line naming the file and the mismatch.
+class CheckpointError : public InputError {
+public:
+    using InputError::InputError;
+};
+
+// 64-bit FNV-1a, fed in pieces.
+class Checksum {
+public:
+    void add(const void* data, std::size_t bytes) {
+        const auto* p = static_cast<const unsigned char*>(data);
+        for (std::size_t i = 0; i < bytes; ++i) value_ = (value_ ^ p[i]) * 0x100000001b3ull;
+    }
+    std::uint64_t value() const { return value_; }
+
+private:
+    std::uint64_t value_ = 0xcbf29ce484222325ull;
+};
+
+class StateWriter {
+public:
+    explicit StateWriter(std::ostream& out) : out_(out) {}
+
+    void bytes(const void* data, std::size_t count) {
+        checksum_.add(data, count);
+        out_.write(static_cast<const char*>(data), static_cast<std::streamsize>(count));
+    }
+    template <class T>
+    void value(const T& v) {
+        static_assert(std::is_trivially_copyable_v<T>);
+        bytes(&v, sizeof v);
+    }
+    template <class T>
+    void array(const std::vector<T>& v) {
+        static_assert(std::is_trivially_copyable_v<T>);
+        value<std::uint64_t>(v.size());
+        bytes(v.data(), v.size() * sizeof(T));
+    }
+    void text(std::string_view s) {
+        value<std::uint64_t>(s.size());
+        bytes(s.data(), s.size());
+    }
+    // A section mark: four letters.
+    void tag(std::string_view name) { bytes(name.data(), 4); }
+
+    std::uint64_t checksum() const { return checksum_.value(); }
+    bool good() const { return static_cast<bool>(out_); }
+
+private:
+    std::ostream& out_;
+    Checksum checksum_;
+};
+
+class StateReader {
+public:
+    // `size`: the bytes that may be read from `in`; `source` names the file in messages.
+    StateReader(std::istream& in, std::uint64_t size, std::string source)
+        : in_(in), left_(size), source_(std::move(source)) {}
+
+    void bytes(void* data, std::size_t count) {
+        if (count > left_) fail("it ends early (a damaged or truncated checkpoint)");
+        in_.read(static_cast<char*>(data), static_cast<std::streamsize>(count));
+        if (!in_) fail("reading it failed");
+        left_ -= count;
+        checksum_.add(data, count);
+    }
+    template <class T>
+    T value() {
+        static_assert(std::is_trivially_copyable_v<T>);
+        T v;
+        bytes(&v, sizeof v);
+        return v;
+    }
+    // Reads an array; its length must fit in what is left of the file (and at most `max_count`).
+    template <class T>
+    void array(std::vector<T>& v, std::uint64_t max_count = UINT64_MAX) {
+        static_assert(std::is_trivially_copyable_v<T>);
+        const auto n = value<std::uint64_t>();
+        if (n > max_count || n > left_ / sizeof(T)) fail("an array is longer than the file (a damaged checkpoint)");
+        v.resize(static_cast<std::size_t>(n));
+        bytes(v.data(), v.size() * sizeof(T));
+    }
+    template <class T>
+    std::vector<T> array() {
+        std::vector<T> v;
+        array(v);
+        return v;
+    }
+    std::string text() {
+        const auto n = value<std::uint64_t>();
+        if (n > left_) fail("a text is longer than the file (a damaged checkpoint)");
+        std::string s(static_cast<std::size_t>(n), '\0');
+        bytes(s.data(), s.size());
+        return s;
+    }
+    void tag(std::string_view name) {
+        char got[4];
+        bytes(got, 4);
+        if (std::string_view(got, 4) != name.substr(0, 4)) {
+            fail("section \"" + std::string(name) + "\" is missing (a damaged checkpoint, or one of another format)");
+        }
+    }
+
+    [[noreturn]] void fail(const std::string& what) const { throw CheckpointError("checkpoint " + source_ + ": " + what); }
+    std::uint64_t left() const { return left_; }
+    std::uint64_t checksum() const { return checksum_.value(); }
+    const std::string& source() const { return source_; }
+
+private:
+    std::istream& in_;
+    std::uint64_t left_;
+    std::string source_;
+    Checksum checksum_;
+};
+
+// Compressed rows: write_rows stores them; read_rows reads `rows_expected` rows (SIZE_MAX: any
+// number) whose entries must all be below `index_limit`, or fails.
+struct CompressedRows;
+void write_rows(StateWriter& out, const CompressedRows& rows);
+void read_rows(StateReader& in, CompressedRows& rows, std::size_t rows_expected, std::size_t index_limit);
+
+}  // namespace gpa

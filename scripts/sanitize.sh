@@ -1,0 +1,52 @@
+#!/usr/bin/env bash
+# The test suite under the address and undefined-behaviour sanitizers, then the libFuzzer target
+# on the scene reader for a bounded time. One clang build (build-asan) serves both.
+# Usage: scripts/sanitize.sh [FUZZ_SECONDS]   (default 60; 0 skips the fuzzing)
+# The tests labelled `slow` (long physics runs) and `install` (a consumer built with the system
+# compiler against these libraries) are left out, and so are the long accuracy runs of gpa_tests. Needs clang and libFuzzer (scripts/install-deps.sh).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+fuzz_seconds=${1:-60}
+build=build-asan
+jobs=$(nproc)
+
+# -O1 and line tables only: the quickest build that still gives stack traces with lines.
+flags="-fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer -fsanitize=fuzzer-no-link"
+mkdir -p "$build"
+cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_FLAGS_RELEASE="-O1 -gline-tables-only" \
+  -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ \
+  -DCMAKE_CXX_FLAGS="$flags" -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined" \
+  -DGPA_BUILD_BENCHMARKS=OFF -DGPA_BUILD_FUZZERS=ON > "$build/configure.log" || { cat "$build/configure.log"; exit 1; }
+cmake --build "$build" -j"$jobs"
+
+# Reports inside third-party headers only, each explained in the file.
+export UBSAN_OPTIONS="suppressions=$PWD/tests/fuzz/ubsan.supp:print_stacktrace=1:halt_on_error=1"
+export ASAN_OPTIONS="detect_leaks=1:abort_on_error=0:strict_string_checks=1"
+# Left out besides, to keep CI within its time: the long accuracy runs of gpa_tests (Taylor bars,
+# the elastic bar, the Armco cylinder's energy balance), minutes each under the sanitizers, whose
+# kernels and phases the shorter tests run too; and cli_bad_input, whose malformed scenes the
+# Corpus tests and the fuzz target read under the sanitizers already (its gpa study runs are the
+# minutes it would take).
+ctest --test-dir "$build" --output-on-failure -j"$jobs" -LE "slow|install" \
+  -E "^(Taylor\.|ElasticBar\.|ArmcoCylinder\.|cli_bad_input$)"
+
+if [[ $fuzz_seconds -gt 0 ]]; then
+  corpus="$build/fuzz-corpus"
+  mkdir -p "$corpus"
+  seeds=(scenes tests/io/bad_scenes tests/io/good_scenes tests/cli)
+  echo "== fuzzing the scene reader for $fuzz_seconds s (seeds: ${seeds[*]}) =="
+  # -rss_limit_mb: a scene may make the set-up allocate up to the target's 16 MiB limit.
+  set +e
+  "$build/tests/fuzz/gpa_fuzz_scene" "$corpus" "${seeds[@]}" -dict=tests/fuzz/scene.dict \
+    -max_total_time="$fuzz_seconds" -timeout=20 -rss_limit_mb=2048 -max_len=16384 -print_final_stats=1 \
+    -artifact_prefix="$build/" > "$build/fuzz.log" 2>&1
+  status=$?
+  set -e
+  grep -E "INFO: seed corpus|^Done |stat::(number_of_executed_units|average_exec_per_sec|new_units_added|peak_rss_mb)|ERROR|SUMMARY|runtime error|Test unit written" \
+    "$build/fuzz.log" || true
+  if [[ $status -ne 0 ]]; then
+    tail -60 "$build/fuzz.log"
+    echo "the fuzz target failed (exit $status); the input that did it is in $build/ (crash-*, leak-*, timeout-*)"
+    exit 1
+  fi
+fi

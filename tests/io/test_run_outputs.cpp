@@ -1,0 +1,261 @@
+// What a run leaves on disk when things go wrong: one run per folder (the lock), whole lines and
+// no temporary files when the disk fills (simulated with a file-size limit, RLIMIT_FSIZE: writes
+// past it fail with EFBIG as on a full disk), marked snapshots in the .pvd; and the scene reader's
+// guards (a size limit however the file is opened, non-ASCII text only where TOML allows it).
+
+#include <algorithm>
+#include <csignal>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include "gpa/engine/simulation.hpp"
+#include "gpa/io/folder_lock.hpp"
+#include "gpa/io/output.hpp"
+#include "gpa/io/scene_file.hpp"
+
+namespace gpa::io {
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path scratch(const std::string& name) {
+    const fs::path dir = fs::temp_directory_path() / fmt::format("gpa_run_outputs_{}_{}", ::getpid(), name);
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    return dir;
+}
+
+std::string read_all(const fs::path& file) {
+    std::ifstream in(file, std::ios::binary);
+    std::ostringstream s;
+    s << in.rdbuf();
+    return s.str();
+}
+
+bool has_tmp_files(const fs::path& dir) {
+    for (const auto& e : fs::recursive_directory_iterator(dir)) {
+        if (e.path().extension() == ".tmp") return true;
+    }
+    return false;
+}
+
+// Files of this process may grow to `bytes` only while it lives (SIGXFSZ ignored, so that the
+// write fails with EFBIG instead of ending the process).
+class FileSizeLimit {
+public:
+    explicit FileSizeLimit(rlim_t bytes) {
+        previous_signal_ = std::signal(SIGXFSZ, SIG_IGN);
+        ::getrlimit(RLIMIT_FSIZE, &previous_);
+        rlimit limit = previous_;
+        limit.rlim_cur = bytes;
+        ::setrlimit(RLIMIT_FSIZE, &limit);
+    }
+    ~FileSizeLimit() {
+        ::setrlimit(RLIMIT_FSIZE, &previous_);
+        std::signal(SIGXFSZ, previous_signal_);
+    }
+
+private:
+    rlimit previous_{};
+    void (*previous_signal_)(int) = nullptr;
+};
+
+const char* tiny_scene = R"(
+name = "tiny"
+geometry = "axisymmetric"
+[[material]]
+name = "elastic steel"
+density = "7800 kg/m^3"
+shear_modulus = "80 GPa"
+eos = { model = "linear", bulk_modulus = "160 GPa" }
+strength = "elastic"
+[[body]]
+name = "bar"
+shape = "cylinder"
+material = "elastic steel"
+radius = "1 mm"
+length = "4 mm"
+spacing = "0.25 mm"
+velocity = [0, "-50 m/s"]
+[[plane]]
+name = "anvil"
+kind = "rigid"
+axis = "z"
+position = 0
+[stop]
+max_steps = 20
+)";
+
+TEST(FolderLock, ASecondRunOnTheSameFolderIsRefusedAtOnce) {
+    const fs::path dir = scratch("lock");
+    const fs::path folder = dir / "run";
+    {
+        FolderLock first(folder);
+        EXPECT_EQ(first.file(), dir / "run.lock");
+        EXPECT_EQ(read_all(first.file()), fmt::format("{}\n", ::getpid()));
+        try {
+            FolderLock second(folder / "");  // "run/" is the same folder
+            ADD_FAILURE() << "two locks on one folder";
+        } catch (const OutputError& e) {
+            const std::string m = e.what();
+            EXPECT_NE(m.find("in use by another gpa run"), std::string::npos) << m;
+            EXPECT_NE(m.find(fmt::format("process {}", ::getpid())), std::string::npos) << m;
+            EXPECT_NE(m.find("run.lock"), std::string::npos) << m;
+        }
+        // A RunFolder takes the same lock before it touches anything.
+        fs::create_directories(dir / "run.partial");
+        std::ofstream(dir / "run.partial" / "history.csv") << "the first run's rows\n";
+        EXPECT_THROW(RunFolder(folder, false), OutputError);
+        EXPECT_EQ(read_all(dir / "run.partial" / "history.csv"), "the first run's rows\n");
+    }
+    EXPECT_FALSE(fs::exists(dir / "run.lock")) << "the lock file goes with its run";
+    // A lock file left by a run that died (kill -9) holds no lock: the next run takes it over.
+    std::ofstream(dir / "run.lock") << "999999999\n";
+    EXPECT_NO_THROW(FolderLock again(folder));
+    fs::remove_all(dir);
+}
+
+TEST(DiskFull, HistoryKeepsWholeLines) {
+    const fs::path dir = scratch("history");
+    const Scene scene = parse_scene(tiny_scene, "tiny.toml");
+    Simulation sim(scene, 1);
+    const fs::path file = dir / "history.csv";
+    std::string message;
+    {
+        HistoryWriter history(file, sim.totals(), 2);
+        const FileSizeLimit limit(3000);  // the header and a few rows
+        try {
+            for (int k = 0; k < 100; ++k) history.write(sim.totals());
+        } catch (const OutputError& e) {
+            message = e.what();
+        }
+    }
+    EXPECT_NE(message.find("history.csv"), std::string::npos) << message;
+    const std::string text = read_all(file);
+    ASSERT_FALSE(text.empty());
+    EXPECT_LE(text.size(), 3000u);
+    EXPECT_EQ(text.back(), '\n') << "the file ends with a whole line";
+    // Every line has the header's number of columns.
+    std::istringstream lines(text);
+    std::string header, line;
+    std::getline(lines, header);
+    const auto columns = std::count(header.begin(), header.end(), ',');
+    int rows = 0;
+    while (std::getline(lines, line)) {
+        EXPECT_EQ(std::count(line.begin(), line.end(), ','), columns) << line;
+        ++rows;
+    }
+    EXPECT_GT(rows, 0);
+    fs::remove_all(dir);
+}
+
+TEST(DiskFull, AFileWrittenAtomicallyIsTheOldOneOrTheNewOneAndLeavesNoTemporaryFile) {
+    const fs::path dir = scratch("atomic");
+    const fs::path file = dir / "summary.json";
+    write_text_file(file, "old\n");
+    {
+        const FileSizeLimit limit(1000);
+        EXPECT_THROW(write_text_file(file, std::string(5000, 'x')), OutputError);
+    }
+    EXPECT_EQ(read_all(file), "old\n");
+    EXPECT_FALSE(has_tmp_files(dir));
+    // A body that throws leaves no temporary file either.
+    EXPECT_THROW(write_file_atomically(file, [](std::ofstream&) { throw OutputError("the body failed"); }), OutputError);
+    EXPECT_FALSE(has_tmp_files(dir));
+    EXPECT_EQ(read_all(file), "old\n");
+    fs::remove_all(dir);
+}
+
+TEST(DiskFull, ASnapshotThatDoesNotFitLeavesTheSeriesAsItWas) {
+    const fs::path dir = scratch("snapshots");
+    const Scene scene = parse_scene(tiny_scene, "tiny.toml");
+    Simulation sim(scene, 1);
+    SnapshotSeries series(dir);
+    series.write(sim.nodes(), sim.real_count(), 0.0);
+    const std::string pvd = read_all(dir / "particles.pvd");
+    {
+        const FileSizeLimit limit(4000);  // a snapshot of 64 nodes is about 14 kB
+        EXPECT_THROW(series.write(sim.nodes(), sim.real_count(), 1e-6), OutputError);
+    }
+    EXPECT_EQ(read_all(dir / "particles.pvd"), pvd);
+    EXPECT_FALSE(fs::exists(dir / "particles_00001.vtp"));
+    EXPECT_FALSE(has_tmp_files(dir));
+    fs::remove_all(dir);
+}
+
+TEST(Snapshots, OnesOutsideTheScheduleAreMarkedInThePvd) {
+    const fs::path dir = scratch("marked");
+    const Scene scene = parse_scene(tiny_scene, "tiny.toml");
+    Simulation sim(scene, 1);
+    SnapshotSeries series(dir);
+    series.write(sim.nodes(), sim.real_count(), 0.0);
+    EXPECT_EQ(series.write_marked(sim.nodes(), sim.real_count(), 2e-8, "failed_step0000003", "failed step 3"),
+              "particles_failed_step0000003.vtp");
+    series.write(sim.nodes(), sim.real_count(), 3e-8);
+    const std::string pvd = read_all(dir / "particles.pvd");
+    EXPECT_NE(pvd.find(R"(file="particles_failed_step0000003.vtp" name="failed step 3")"), std::string::npos) << pvd;
+    EXPECT_NE(pvd.find(R"(file="particles_00001.vtp"/>)"), std::string::npos) << "the schedule's numbering goes on: " << pvd;
+    EXPECT_EQ(series.scheduled(), 2u);
+    EXPECT_EQ(series.count(), 3u);
+    fs::remove_all(dir);
+}
+
+TEST(SceneText, IsReadWithASizeLimitHoweverTheFileIsOpened) {
+    // A device that never ends (and reports no size).
+    try {
+        read_scene_text("/dev/zero");
+        ADD_FAILURE() << "/dev/zero was read";
+    } catch (const SceneError& e) {
+        EXPECT_NE(std::string(e.what()).find("too large for a scene file"), std::string::npos) << e.what();
+    }
+    EXPECT_THROW(load_scene("/dev/zero"), SceneError);
+}
+
+TEST(SceneText, NonAsciiTextIsAcceptedWhereTomlAllowsIt) {
+    // U+03FB (bytes CF BB) reaches undefined behaviour in toml++ 3.3.0 outside strings; inside
+    // strings, comments and quoted keys it is ordinary text.
+    const std::string text = std::string("\xEF\xBB\xBF") +  // a byte-order mark
+                             "# a comment with \xCF\xBB in it\n"
+                             "description = \"\xCF\xBB basic\"\n" +
+                             tiny_scene +
+                             "[reference]\n"
+                             "source = '''multi-line \xCF\xBB\nliteral'''\n"
+                             "\"\xCF\xBB quoted key\" = 1.0\n";
+    Scene s;
+    ASSERT_NO_THROW(s = parse_scene(text, "unicode.toml"));
+    EXPECT_EQ(s.description, "\xCF\xBB basic");
+    EXPECT_EQ(s.reference.at("\xCF\xBB quoted key"), 1.0);
+    const std::string multi = std::string("description = \"\"\"line one \xCF\xBB\nline \\\"two\\\" \"\"\"\n") + tiny_scene;
+    ASSERT_NO_THROW(s = parse_scene(multi, "multi.toml"));
+    EXPECT_EQ(s.description, "line one \xCF\xBB\nline \"two\" ");
+}
+
+TEST(SceneText, NonAsciiTextOutsideStringsIsRefusedWithItsLine) {
+    for (const auto& [text, line] : std::vector<std::pair<std::string, int>>{
+             {std::string(tiny_scene) + "\xCF\xBB\n", 25},
+             {"\xCF\xBB = 1\n", 1},
+             {"a = 1 \xCF\xBB\n", 1},
+             {"a = [1, \xC2\xA0 2]\n", 1},
+             {"s = \"x\"\xCF\xBB\n", 1},
+             {"s = 'x' # c\n\xCF\xBB\n", 2},
+         }) {
+        try {
+            parse_scene(text, "bad.toml");
+            ADD_FAILURE() << "accepted: " << text;
+        } catch (const SceneError& e) {
+            const std::string m = e.what();
+            EXPECT_EQ(m.rfind(fmt::format("bad.toml:{}:", line), 0), 0u) << m;
+            EXPECT_NE(m.find("non-ASCII character outside a quoted string"), std::string::npos) << m;
+        }
+    }
+}
+
+}  // namespace
+}  // namespace gpa::io

@@ -1,0 +1,235 @@
+// Checkpoints (Simulation::save_checkpoint / restore_checkpoint): a run stopped at any step and
+// continued from its checkpoint, on another thread count, ends with node data identical byte
+// for byte to a run never stopped; a checkpoint of another scene, build or format, or a damaged
+// one, is refused with a message.
+
+#include <cstring>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "gpa/engine/errors.hpp"
+#include "gpa/engine/simulation.hpp"
+#include "gpa/engine/state_io.hpp"
+#include "support/scenes.hpp"
+
+namespace gpa {
+namespace {
+
+// Every field of every node (ghosts included) and the fixed lists, as bytes.
+std::string node_bytes(const Simulation& sim) {
+    std::ostringstream out;
+    StateWriter w(out);
+    sim.nodes().write_state(w);
+    return out.str();
+}
+
+// The totals a history row and a summary print, as bytes.
+std::string totals_bytes(const Totals& t) {
+    std::string out;
+    const auto add = [&](const auto& v) { out.append(reinterpret_cast<const char*>(&v), sizeof v); };
+    for (const double v : {t.time, t.time_step, t.kinetic_energy, t.internal_energy, t.plastic_work, t.viscous_work,
+                           t.boundary_work, t.energy_error, t.momentum[0], t.momentum[1], t.momentum[2], t.length,
+                           t.footprint_diameter}) {
+        add(v);
+    }
+    for (const std::size_t v : {t.step, t.real_nodes, t.ghost_nodes, t.variable_nodes, t.failed_nodes, t.pairs,
+                                t.neighbour_searches}) {
+        add(v);
+    }
+    for (const auto& p : t.planes) {
+        add(p.reaction);
+        add(p.impulse);
+    }
+    return out;
+}
+
+std::string checkpoint_of(const Simulation& sim, const std::string& fingerprint = "scene-a", const std::string& user = "") {
+    std::ostringstream out;
+    sim.save_checkpoint(out, fingerprint, user);
+    return out.str();
+}
+
+std::string restore(Simulation& sim, const std::string& bytes, const std::string& fingerprint = "scene-a") {
+    std::istringstream in(bytes);
+    return sim.restore_checkpoint(in, bytes.size(), "test", fingerprint);
+}
+
+Scene three_d_quarter_bar(int radial_cells) {
+    auto scene = testing::armco_cylinder(radial_cells, 40e-6);
+    scene.geometry = GeometryKind::ThreeD;
+    auto& bar = scene.bodies[0];
+    bar.shape = ShapeKind::Box;
+    bar.size = {bar.radius, bar.radius, bar.length};
+    bar.origin = {0.0, 0.0, 0.0};
+    bar.velocity = {0.0, 0.0, -305.0};
+    scene.planes[0].axis = 2;
+    for (int axis : {0, 1}) {
+        PlaneSpec p;
+        p.name = axis == 0 ? "x = 0" : "y = 0";
+        p.kind = PlaneKind::Symmetry;
+        p.axis = axis;
+        scene.planes.push_back(p);
+    }
+    return scene;
+}
+
+struct Case {
+    const char* name;
+    Scene scene;
+    int stop_at;  // the step of the checkpoint
+    int steps;    // the steps of the whole run
+    bool both_ways = false;  // stopped on 1 thread and resumed on 2, and the other way round; else 1 -> 2
+};
+
+std::vector<Case> cases() {
+    std::vector<Case> out;
+    {
+        // About 4800 nodes: every parallel loop and reduction is split over several ranges.
+        auto scene = testing::armco_cylinder(40, 40e-6);
+        scene.solver.reorder_interval = 20;  // reorderings before and after the checkpoint
+        out.push_back({"axisymmetric Taylor bar, variable, skin, reordering", scene, 27, 45, true});
+    }
+    {
+        auto scene = testing::armco_cylinder(12, 40e-6);
+        scene.solver.connectivity = ConnectivityMode::Automatic;  // switching: searches forced mid-skin
+        scene.solver.switch_plastic_strain = 0.05;
+        scene.solver.smoothing = SmoothingMode::Everywhere;
+        out.push_back({"automatic switching with smoothing", scene, 131, 180});
+    }
+    {
+        auto scene = testing::elastic_bar_on_plane(1e-3, 12e-3, 8, 100.0);  // lift-off contacts come and go
+        scene.solver.viscosity = ViscosityKind::Bond;  // largest_bond_q is read by the next step's time step
+        scene.solver.smoothing = SmoothingMode::Tension;
+        scene.stop = {};
+        scene.stop.max_steps = 100000;
+        out.push_back({"elastic bar on a lift-off plane, bond viscosity", scene, 211, 300});
+    }
+    {
+        auto scene = three_d_quarter_bar(4);
+        scene.solver.connectivity = ConnectivityMode::Automatic;
+        scene.solver.switch_plastic_strain = 0.05;
+        out.push_back({"3D quarter bar on symmetry planes, automatic", scene, 47, 70});
+    }
+    {
+        auto scene = testing::armco_cylinder(10, 40e-6);
+        scene.solver.neighbour_skin = 0.0;  // a search and a plan every step
+        scene.solver.scatter = ScatterScheme::Graph;
+        out.push_back({"no skin, graph colouring", scene, 0, 60});  // a checkpoint before the first step
+    }
+    return out;
+}
+
+TEST(Checkpoint, AResumedRunIsBitIdenticalToOneNeverStoppedOnOneAndTwoThreads) {
+    for (auto& c : cases()) {
+        SCOPED_TRACE(c.name);
+        std::vector<std::pair<int, int>> threads{{1, 2}};
+        if (c.both_ways) threads.push_back({2, 1});
+        for (const auto& [first, second] : threads) {
+            SCOPED_TRACE(::testing::Message() << "stopped on " << first << " thread(s), resumed on " << second);
+            // The run that is never stopped writes the checkpoint on its way (writing one
+            // changes nothing: WritingOneChangesNothing); another Simulation resumes from it.
+            Simulation never_stopped(c.scene, first);
+            for (int k = 0; k < c.stop_at; ++k) never_stopped.step();
+            const std::string saved = checkpoint_of(never_stopped, "scene-a", "user data");
+            Simulation resumed(c.scene, second);
+            ASSERT_EQ(restore(resumed, saved), "user data");
+            ASSERT_EQ(resumed.steps(), static_cast<std::size_t>(c.stop_at));
+            for (int k = c.stop_at; k < c.steps; ++k) never_stopped.step();
+            for (int k = c.stop_at; k < c.steps; ++k) resumed.step();
+            ASSERT_EQ(never_stopped.steps(), resumed.steps());
+            EXPECT_TRUE(node_bytes(never_stopped) == node_bytes(resumed)) << "node data differ after " << c.steps << " steps";
+            EXPECT_TRUE(totals_bytes(never_stopped.totals()) == totals_bytes(resumed.totals()));
+            EXPECT_TRUE(never_stopped.neighbour_lists() == resumed.neighbour_lists());
+            EXPECT_EQ(never_stopped.node_steps(), resumed.node_steps());
+        }
+    }
+}
+
+TEST(Checkpoint, WritingOneChangesNothing) {
+    // A run that writes checkpoints is the run that does not: save_checkpoint only reads.
+    const auto scene = testing::armco_cylinder(12, 40e-6);
+    Simulation plain(scene, 2), saving(scene, 2);
+    for (int k = 0; k < 120; ++k) {
+        plain.step();
+        saving.step();
+        if (k % 7 == 0) (void)checkpoint_of(saving);
+    }
+    EXPECT_TRUE(node_bytes(plain) == node_bytes(saving));
+}
+
+template <class F>
+std::string refusal(F&& f) {
+    try {
+        f();
+    } catch (const CheckpointError& e) {
+        return e.what();
+    }
+    ADD_FAILURE() << "no CheckpointError";
+    return {};
+}
+
+TEST(Checkpoint, ThoseOfAnotherSceneBuildOrFormatAreRefusedBeforeAnythingChanges) {
+    const auto scene = testing::armco_cylinder(8, 40e-6);
+    Simulation a(scene, 1);
+    for (int k = 0; k < 30; ++k) a.step();
+    const std::string saved = checkpoint_of(a);
+    const auto info_of = [](const std::string& bytes) {
+        std::istringstream in(bytes);
+        return Simulation::checkpoint_info(in, bytes.size(), "test");
+    };
+    EXPECT_EQ(info_of(saved).step, 30u);
+    EXPECT_EQ(info_of(saved).scene_fingerprint, "scene-a");
+    EXPECT_EQ(info_of(saved).format, Simulation::checkpoint_format);
+
+    Simulation b(scene, 1);
+    const std::string before = node_bytes(b);
+    auto m = refusal([&] { restore(b, saved, "scene-b"); });
+    EXPECT_NE(m.find("another scene"), std::string::npos) << m;
+    // Another build: the build id is the first text of the header.
+    std::string other_build = saved;
+    const auto at = other_build.find("gpa ");
+    ASSERT_NE(at, std::string::npos);
+    other_build[at + 4] = 'X';
+    m = refusal([&] { restore(b, other_build); });
+    EXPECT_NE(m.find("written by"), std::string::npos) << m;
+    // Another format version (bytes 8-11).
+    std::string other_format = saved;
+    other_format[8] = 99;
+    m = refusal([&] { restore(b, other_format); });
+    EXPECT_NE(m.find("format 99"), std::string::npos) << m;
+    m = refusal([&] { restore(b, std::string("not a checkpoint at all")); });
+    EXPECT_NE(m.find("not a gpa checkpoint"), std::string::npos) << m;
+    // None of these touched b: it still steps like a fresh run.
+    EXPECT_TRUE(node_bytes(b) == before);
+    EXPECT_NO_THROW(b.step());
+}
+
+TEST(Checkpoint, DamagedOnesAreRefusedAndLeaveTheSimulationUnusable) {
+    const auto scene = testing::armco_cylinder(8, 40e-6);
+    Simulation a(scene, 1);
+    for (int k = 0; k < 30; ++k) a.step();
+    const std::string saved = checkpoint_of(a);
+    std::string flipped = saved;
+    flipped[saved.size() / 2] ^= 0x10;  // one bit in the node data
+    Simulation b(scene, 1);
+    auto m = refusal([&] { restore(b, flipped); });
+    EXPECT_NE(m.find("damaged"), std::string::npos) << m;
+    EXPECT_THROW(b.step(), NumericalError);
+
+    for (const std::size_t cut : {std::size_t{1}, std::size_t{100}, saved.size() / 3}) {
+        Simulation c(scene, 1);
+        m = refusal([&] { restore(c, saved.substr(0, saved.size() - cut)); });
+        EXPECT_FALSE(m.empty());
+    }
+    // A checkpoint of another scene under the same fingerprint (a caller's mistake) is refused
+    // too, not read into arrays of another size.
+    Simulation other(testing::armco_cylinder(10, 40e-6), 1);
+    m = refusal([&] { restore(other, saved); });
+    EXPECT_NE(m.find("nodes"), std::string::npos) << m;
+}
+
+}  // namespace
+}  // namespace gpa

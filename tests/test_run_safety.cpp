@@ -1,0 +1,160 @@
+// Runs that go wrong say where: a failing step names its number (the first step is 1), time,
+// phase, node, body, position and field; the energy guard stops an unstable run; sizes from the
+// input are checked against the memory limit before they are allocated.
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "gpa/engine/errors.hpp"
+#include "gpa/engine/limits.hpp"
+#include "gpa/engine/simulation.hpp"
+#include "support/scenes.hpp"
+
+namespace gpa {
+namespace {
+
+// Runs until a step fails; returns its report (and fails the test if none did).
+StepFailure first_failure(Simulation& sim, int max_steps) {
+    for (int k = 0; k < max_steps && !sim.finished(); ++k) {
+        try {
+            sim.step();
+        } catch (const StepFailure& f) {
+            return f;
+        }
+    }
+    ADD_FAILURE() << "no step failed in " << max_steps << " steps";
+    return StepFailure("none", {});
+}
+
+bool has(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+TEST(StepFailures, NameTheStepTheTimeThePhaseAndTheNode) {
+    // 10 km/s into the anvil with the guard off: a node is crushed within a few steps.
+    auto scene = testing::elastic_bar_on_plane(1e-3, 4e-3, 4, 1e4);
+    scene.stop.energy_error = 0.0;
+    Simulation sim(scene, 2);
+    const std::size_t steps_before = [&] {
+        Simulation probe(scene, 1);
+        std::size_t done = 0;
+        try {
+            while (!probe.finished()) {
+                probe.step();
+                ++done;
+            }
+        } catch (const StepFailure&) {
+        }
+        return done;
+    }();
+    const StepFailure f = first_failure(sim, 1000);
+    const FailureSite& s = f.site();
+    EXPECT_EQ(s.step, steps_before + 1) << "the failing step is counted from 1, one more than the steps done";
+    EXPECT_EQ(s.step, sim.steps() + 1);
+    EXPECT_EQ(s.time, sim.time());
+    const auto phases = sim.phases();
+    EXPECT_NE(std::find(phases.begin(), phases.end(), s.phase), phases.end()) << s.phase;
+    ASSERT_TRUE(s.node.has_value()) << f.what();
+    EXPECT_LT(*s.node, sim.nodes().size());
+    EXPECT_EQ(s.body, "bar");
+    EXPECT_FALSE(s.field.empty());
+    for (int c = 0; c < 2; ++c) EXPECT_EQ(s.position[c], sim.nodes().position[c][*s.node]);
+    const std::string m = f.what();
+    EXPECT_TRUE(has(m, "step " + std::to_string(s.step)) && has(m, "phase \"" + s.phase + "\"") &&
+                has(m, "node " + std::to_string(*s.node)) && has(m, "body \"bar\"") && has(m, "field " + s.field))
+        << m;
+    EXPECT_EQ(m.find('\n'), std::string::npos) << "one line: " << m;
+    // The state is half-updated: no further step.
+    EXPECT_THROW(sim.step(), NumericalError);
+}
+
+TEST(EnergyGuard, StopsARunWithTooLongATimeStep) {
+    auto scene = testing::elastic_bar_on_plane(1e-3, 4e-3, 4, 50.0);
+    scene.solver.cfl = 1.0;  // past the stable range (docs/scene-format.md, solver.cfl)
+    scene.stop = {};
+    scene.stop.max_steps = 2000;
+    Simulation sim(scene, 1);
+    const StepFailure f = first_failure(sim, 2000);
+    const FailureSite& s = f.site();
+    EXPECT_EQ(s.phase, "totals");
+    EXPECT_EQ(s.field, "total energy");
+    EXPECT_EQ(s.body, "bar");
+    EXPECT_EQ(s.step, sim.steps()) << "the guard checks a completed step";
+    EXPECT_GT(std::abs(sim.totals().energy_error), 0.03);
+    EXPECT_TRUE(has(f.what(), "stop.energy_error = 3 %")) << f.what();
+    EXPECT_THROW(sim.step(), NumericalError);
+
+    // The same run at the default C_cfl stays within the guard for all 2000 steps.
+    scene.solver.cfl = SolverOptions{}.cfl;
+    Simulation stable(scene, 1);
+    for (int k = 0; k < 2000 && !stable.finished(); ++k) ASSERT_NO_THROW(stable.step()) << "step " << k + 1;
+    EXPECT_LT(std::abs(stable.totals().energy_error), 0.03);
+}
+
+TEST(EnergyGuard, ZeroTurnsItOff) {
+    auto scene = testing::elastic_bar_on_plane(1e-3, 4e-3, 4, 50.0);
+    scene.solver.cfl = 1.0;
+    scene.stop = {};
+    scene.stop.max_steps = 40;
+    scene.stop.energy_error = 0.0;
+    Simulation sim(scene, 1);
+    double worst = 0.0;
+    for (int k = 0; k < 40 && !sim.finished(); ++k) {
+        try {
+            sim.step();
+        } catch (const StepFailure&) {
+            break;  // another kind of failure may end it; the guard is not what stops it
+        }
+        worst = std::max(worst, std::abs(sim.totals().energy_error));
+    }
+    EXPECT_GT(worst, 0.03) << "the unguarded run passes the 3 % the guard would have stopped";
+}
+
+TEST(EnergyGuard, IsAValidatedSceneOption) {
+    auto scene = testing::elastic_bar_on_plane(1e-3, 4e-3, 4, 50.0);
+    scene.stop.energy_error = -0.1;
+    EXPECT_THROW(validate_scene(scene), InputError);
+    scene.stop.energy_error = std::nan("");
+    EXPECT_THROW(validate_scene(scene), InputError);
+}
+
+TEST(MemoryLimit, NodesBeyondItAreRefusedBeforeTheyAreMade) {
+    auto scene = testing::elastic_bar_on_plane(1e-3, 4e-3, 4, 50.0);
+    const double nodes = estimated_node_count(scene);
+    EXPECT_EQ(nodes, 4.0 * 16.0);  // 4 cells across the radius, 16 along the length
+    MemoryLimit limit{1000, "a test limit"};
+    try {
+        Simulation sim(scene, 1, limit);
+        ADD_FAILURE() << "a 1000-byte limit was accepted";
+    } catch (const LimitError& e) {
+        const std::string m = e.what();
+        EXPECT_TRUE(has(m, "64 nodes") && has(m, "1000 B") && has(m, "a test limit")) << m;
+    }
+    // A spacing of 1 nm on the same bar: 10^6 x 4 10^6 cells, refused at once.
+    scene.bodies[0].spacing = 1e-9;
+    EXPECT_THROW(Simulation(scene, 1), LimitError);
+    EXPECT_GT(estimated_node_count(scene), 1e12);
+}
+
+TEST(MemoryLimit, NeighbourListsAreCheckedBeforeASearchAllocatesThem) {
+    // At the largest influence distance the lists hold about twice the pairs per node that the
+    // set-up estimate assumes: a limit just above that estimate passes set-up's check of the
+    // nodes and refuses the first search (in set-up), before its lists are allocated.
+    auto scene = testing::armco_cylinder(10, 40e-6);
+    scene.solver.influence_distance = 1.5;
+    const double nodes = estimated_node_count(scene);
+    const auto bytes = static_cast<std::uint64_t>(
+        1.02 * nodes * (bytes_per_node_besides_lists(2) + list_entries_per_node(2) * bytes_per_list_entry));
+    try {
+        Simulation sim(scene, 1, MemoryLimit{bytes, "a test limit"});
+        ADD_FAILURE() << "lists of twice the estimated pairs per node fitted";
+    } catch (const LimitError& e) {
+        EXPECT_TRUE(has(e.what(), "neighbour lists")) << e.what();
+    }
+    // With room for them, it runs.
+    EXPECT_NO_THROW(Simulation(scene, 1, MemoryLimit{bytes * 100, "a test limit"}));
+}
+
+}  // namespace
+}  // namespace gpa
