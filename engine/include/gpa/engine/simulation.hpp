@@ -13,6 +13,11 @@
 //   v^{n+3/2} = v^{n+1/2} + (dt^{n+1/2} + dt^{n+3/2})/2 F / M   integrate, [smoothing]
 //   fixed -> variable above the plastic-strain threshold  [switching]
 //
+// Element bodies (elements.hpp) take part in the same step with phases of their own, between the
+// particle phases of the same name: element move after move, element stress after stress,
+// element forces after forces, element integrate after integrate; the time step, the totals and
+// the energy booking cover both.
+//
 // After step() the positions, stresses and energies are those of t^{n+1}; velocities are the
 // half step ahead (v^{n+3/2}), and the kinetic energy reported for t^{n+1} is the mean of the two
 // half steps around it.
@@ -50,11 +55,17 @@ struct Totals {
     std::array<double, 3> momentum{0, 0, 0};  // sum M v^{n+3/2}, kg m/s: half a step ahead, like the impulse
                                               // (the axial component is the meaningful one in axisymmetric)
     std::vector<PlaneReport> planes;          // rigid planes, scene order
-    double length = 0.0;              // max over nodes of (distance from the first rigid plane + d/2), m
-    double footprint_diameter = 0.0;  // width of the nodes within d of the first rigid plane, m
+    // Final length and footprint against the first rigid plane, by the rules of measure.hpp
+    // (docs/measurement.md): particles reach d/2 beyond their centres, element nodes lie on the
+    // boundary.
+    double length = 0.0;              // highest point above the plane, m
+    double footprint_diameter = 0.0;  // width of the body on the plane, m
     std::size_t real_nodes = 0, ghost_nodes = 0, variable_nodes = 0, failed_nodes = 0, pairs = 0;
+    std::size_t element_nodes = 0, elements = 0;  // nodes and quadrilaterals of element bodies
     std::size_t neighbour_searches = 0;  // full searches so far (the others steps reuse candidate lists)
 };
+
+class ElementPart;
 
 class Simulation {
 public:
@@ -84,6 +95,10 @@ public:
     std::vector<std::string> phases() const;
     // Real node-steps processed so far (sum over steps of the real node count).
     double node_steps() const;
+    // Element-steps (quadrilaterals times steps) processed so far.
+    double element_steps() const;
+    // The element bodies (nullptr when the scene has none).
+    const ElementPart* elements() const;
     // The neighbour lists of the last step: rows [0, real_count()) of the real nodes, then the
     // rows of the ghosts (indices >= real_count() are ghosts).
     const CompressedRows& neighbour_lists() const;
