@@ -39,7 +39,7 @@ double snapshot_interval(const Scene& s) {
     return 0.0;
 }
 
-// A copy of the real nodes, written by a background task while the run goes on.
+// A copy of the real nodes and element bodies, written by a background task while the run goes on.
 class SnapshotWriter {
 public:
     explicit SnapshotWriter(fs::path folder) : series_(std::move(folder)) {}
@@ -51,12 +51,9 @@ public:
     }
     void write(const Simulation& sim) {
         wait();
-        NodeStore copy = sim.nodes();
-        copy.resize(sim.real_count());
-        const double t = sim.time();
-        pending_ = std::async(std::launch::async, [this, copy = std::move(copy), t] {
+        pending_ = std::async(std::launch::async, [this, snapshot = io::take_snapshot(sim)] {
             const auto t0 = std::chrono::steady_clock::now();
-            series_.write(copy, copy.size(), t);
+            series_.write(snapshot);
             seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         });
     }

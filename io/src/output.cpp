@@ -86,11 +86,39 @@ void HistoryWriter::write(const Totals& t) {
 SnapshotSeries::SnapshotSeries(fs::path folder, std::string stem) : folder_(std::move(folder)), stem_(std::move(stem)) {}
 
 std::string SnapshotSeries::write(const NodeStore& nodes, std::size_t count, double time) {
-    const std::string name = fmt::format("{}_{:05d}.vtp", stem_, entries_.size());
+    const std::string name = fmt::format("{}_{:05d}.vtp", stem_, snapshots_);
     write_vtp(folder_ / name, nodes, count);
-    entries_.push_back({time, name});
+    entries_.push_back({time, name, 0});
+    ++snapshots_;
     write_pvd(folder_ / (stem_ + ".pvd"), entries_);
     return name;
+}
+
+Snapshot take_snapshot(const Simulation& sim) {
+    Snapshot s;
+    s.time = sim.time();
+    s.particles = sim.nodes();
+    s.particles.resize(sim.real_count());
+    if (const ElementPart* e = sim.elements()) s.elements = e->mesh();
+    return s;
+}
+
+std::vector<std::string> SnapshotSeries::write(const Snapshot& snapshot) {
+    std::vector<std::string> names;
+    int part = 0;
+    if (snapshot.particles.size() > 0 || !snapshot.elements) {
+        names.push_back(fmt::format("{}_{:05d}.vtp", stem_, snapshots_));
+        write_vtp(folder_ / names.back(), snapshot.particles, snapshot.particles.size());
+        entries_.push_back({snapshot.time, names.back(), part++});
+    }
+    if (snapshot.elements) {
+        names.push_back(fmt::format("elements_{:05d}.vtu", snapshots_));
+        write_vtu(folder_ / names.back(), *snapshot.elements);
+        entries_.push_back({snapshot.time, names.back(), part++});
+    }
+    ++snapshots_;
+    write_pvd(folder_ / (stem_ + ".pvd"), entries_);
+    return names;
 }
 
 namespace {

@@ -87,6 +87,7 @@ const std::vector<ChoiceKey> choice_keys{
     {"normalisation", {"per-direction", "moment-matrix"}},
     {"viscosity", {"none", "nodal", "bond"}},
     {"smoothing", {"off", "tension", "everywhere"}},
+    {"discretisation", {"particles", "elements"}},
 };
 
 const std::vector<const char*> number_keys{
@@ -376,6 +377,16 @@ void apply_variant(const Variant& variant, Scene& scene) {
             o.viscosity = value == "none" ? ViscosityKind::None : value == "nodal" ? ViscosityKind::Nodal : ViscosityKind::Bond;
         } else if (key == "smoothing") {
             o.smoothing = value == "off" ? SmoothingMode::Off : value == "tension" ? SmoothingMode::Tension : SmoothingMode::Everywhere;
+        } else if (key == "discretisation") {
+            // Every body, meshed from the same shape at the same spacing; the particle-only body
+            // keys go, since they do not apply to element bodies.
+            for (auto& b : scene.bodies) {
+                b.discretisation = value == "elements" ? Discretisation::Elements : Discretisation::Particles;
+                if (b.discretisation == Discretisation::Elements) {
+                    b.connectivity.reset();
+                    b.lattice_neighbours = 0;
+                }
+            }
         } else {
             const double x = parse_quantity(value, Dimension::Dimensionless);
             if (key == "cfl") o.cfl = x;

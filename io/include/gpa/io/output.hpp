@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <map>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -48,19 +49,33 @@ private:
     std::size_t planes_;
 };
 
-// particles_NNNNN.vtp and particles.pvd in a folder; the index is rewritten after every
-// snapshot so that it always lists the snapshots on disk.
+// What one snapshot shows, copied out of a run so that it can be written while the run goes on:
+// the real particle nodes and the element bodies.
+struct Snapshot {
+    double time = 0.0;
+    NodeStore particles{GeometryKind::Axisymmetric};
+    std::optional<ElementMesh> elements;
+};
+Snapshot take_snapshot(const Simulation& sim);
+
+// particles_NNNNN.vtp (particle bodies), elements_NNNNN.vtu (element bodies) and particles.pvd,
+// the time series of both, in a folder; the index is rewritten after every snapshot so that it
+// always lists the snapshots on disk.
 class SnapshotSeries {
 public:
     explicit SnapshotSeries(std::filesystem::path folder, std::string stem = "particles");
     // Writes nodes [0, count) at time t; returns the file name.
     std::string write(const NodeStore& nodes, std::size_t count, double time);
-    std::size_t count() const { return entries_.size(); }
+    // Writes the snapshot's particles (if any) and element bodies (if any) as parts of one time
+    // step; returns the file names written.
+    std::vector<std::string> write(const Snapshot& snapshot);
+    std::size_t count() const { return snapshots_; }
 
 private:
     std::filesystem::path folder_;
     std::string stem_;
     std::vector<PvdEntry> entries_;
+    std::size_t snapshots_ = 0;
 };
 
 // The summary of a finished (or failed) run.
@@ -79,10 +94,12 @@ struct RunSummary {
 void write_summary(const std::filesystem::path& file, const Simulation& sim, const RunSummary& run);
 
 // profile.csv: the outline of the bodies seen from the first rigid plane, for comparing a
-// Taylor specimen with its measured outline: for bins of height above the plane (one mean node
-// diameter wide), the largest radial extent plus d/2 (axisymmetric: the radius x; otherwise the
-// distance from the vertical through the nodes' centroid). Heights and radii in m. Does nothing
-// without a rigid plane.
+// Taylor specimen with its measured outline (axisymmetric: radius x; otherwise the distance from
+// the vertical through the nodes' centroid), by the rules of measure.hpp. Particle bodies: for
+// bins of height above the plane (one mean node diameter wide), the largest radial extent plus
+// d/2. Element bodies: the outline of the mesh's boundary, the largest radius of the boundary
+// edges at each boundary node's height. Both end with (top, 0). Heights and radii in m. Does
+// nothing without a rigid plane.
 void write_profile(const std::filesystem::path& file, const Simulation& sim);
 
 // The scene's reference answers compared with the run: key -> {reference, computed, relative error}.
