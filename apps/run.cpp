@@ -72,6 +72,7 @@ private:
 void print_report(const Simulation& sim) {
     const auto& t = sim.totals();
     fmt::print("  {} real nodes, {} steps, t = {:.4g} us ({})\n", t.real_nodes, t.step, t.time * 1e6, sim.stop_reason());
+    if (t.elements > 0) fmt::print("  {} elements, {} element nodes\n", t.elements, t.element_nodes);
     if (!t.planes.empty()) {
         fmt::print("  final length {:.4g} mm, footprint diameter {:.4g} mm\n", t.length * 1e3, t.footprint_diameter * 1e3);
     }

@@ -123,17 +123,10 @@ template <class G>
 void mesh_body(const Scene& scene, std::size_t b, ElementMesh& mesh) {
     const BodySpec& body = scene.bodies[b];
     const std::size_t material = material_index(scene, body.material, body.name);
-    const materials::Material& mat = scene.materials[material];
     const LatticeBlock block = body_lattice(scene, b);
     const std::int64_t nx = block.last[0] - block.first[0], nz = block.last[1] - block.first[1];
     const double sx = block.spacing[0], sz = block.spacing[1];
     mesh.body_spacing[b] = std::min(sx, sz);
-
-    // The initial stress: deviator into every triangle, mean stress into an initial compression.
-    const auto& sig = body.initial_stress;
-    const double mean = (sig[0] + sig[1] + sig[3]) / 3.0;
-    const double eps_v = initial_volumetric_strain(mat, -mean, body.name);
-    const double density = mat.density / (1.0 + eps_v);
 
     std::vector<NodeIndex> corner(static_cast<std::size_t>((nx + 1) * (nz + 1)), no_node);
     const auto add_node = [&](double x, double z) {
@@ -169,42 +162,75 @@ void mesh_body(const Scene& scene, std::size_t b, ElementMesh& mesh) {
         throw InputError(fmt::format("body \"{}\": its mesh holds no element (spacing {} m too coarse for its size)", body.name,
                                      body.spacing));
     }
-    // Triangles: masses, initial state; lumped nodal masses (E4).
-    mesh.quads.mass.resize(mesh.quads.size(), 0.0);
-    mesh.quads.volume.resize(mesh.quads.size(), 0.0);
-    mesh.quads.length.resize(mesh.quads.size(), 0.0);
-    mesh.quads.rate.resize(mesh.quads.size(), 0.0);
-    mesh.points.resize(4 * mesh.quads.size());
-    for (std::size_t q = first_quad; q < mesh.quads.size(); ++q) {
+}
+
+// The state of an unloaded mesh at its node positions (elements.hpp, initialise_element_state).
+template <class G>
+void initialise_state(ElementMesh& mesh, const Scene& scene) {
+    ElementQuads& quads = mesh.quads;
+    const std::size_t n = quads.size();
+    quads.mass.assign(n, 0.0);
+    quads.volume.assign(n, 0.0);
+    quads.length.assign(n, 0.0);
+    quads.rate.assign(n, 0.0);
+    mesh.points.resize(0);
+    mesh.points.resize(4 * n);
+    std::fill(mesh.nodes.mass.begin(), mesh.nodes.mass.end(), 0.0);
+    // Each body's initial stress: its deviator into every triangle, its mean stress into an
+    // initial compression (bodies.hpp, as for particles).
+    std::vector<double> density(scene.bodies.size(), 0.0);
+    for (std::size_t b = 0; b < scene.bodies.size(); ++b) {
+        if (scene.bodies[b].discretisation != Discretisation::Elements) continue;
+        const auto& body = scene.bodies[b];
+        const auto& mat = scene.materials.at(material_index(scene, body.material, body.name));
+        const auto& sig = body.initial_stress;
+        density[b] = mat.density / (1.0 + initial_volumetric_strain(mat, -(sig[0] + sig[1] + sig[3]) / 3.0, body.name));
+    }
+    for (std::size_t q = 0; q < n; ++q) {
+        const std::size_t b = static_cast<std::size_t>(quads.body[q]);
+        const BodySpec& body = scene.bodies.at(b);
+        const materials::Material& mat = scene.materials.at(static_cast<std::size_t>(quads.material[q]));
+        const auto& sig = body.initial_stress;
+        const double mean = (sig[0] + sig[1] + sig[3]) / 3.0;
+        const InitialPointState start = initial_material_point(mat, density[b]);
         const auto x = corners_of(mesh, q);
         const auto t = triangles_of<G>(x);
         for (int k = 0; k < 4; ++k) {
             const std::size_t p = 4 * q + static_cast<std::size_t>(k);
-            if (!(t[k].volume > 0.0)) {
-                throw InputError(fmt::format("body \"{}\": element {} has no volume at the start", body.name, q));
+            if (!(t[k].area > 0.0) || !(t[k].volume > 0.0)) {
+                throw InputError(fmt::format("body \"{}\": element {} (triangle {}) has no positive area at the start; its "
+                                             "nodes: {}",
+                                             body.name, q, k, node_list(mesh, q)));
             }
-            const double m = density * t[k].volume;
+            const double m = density[b] * t[k].volume;
             mesh.points.mass[p] = m;
-            mesh.points.density[p] = density;
+            mesh.points.density[p] = density[b];
             mesh.points.volume[p] = t[k].volume;
             mesh.points.deviatoric_stress[0][p] = sig[0] - mean;
             mesh.points.deviatoric_stress[1][p] = sig[1] - mean;
             mesh.points.deviatoric_stress[2][p] = sig[2];
             mesh.points.deviatoric_stress[3][p] = sig[3] - mean;
             mesh.points.temperature[p] = mat.room_temperature;
-            const InitialPointState start = initial_material_point(mat, density);
             mesh.points.pressure[p] = start.pressure;
             mesh.points.sound_speed[p] = start.sound_speed;
-            mesh.quads.mass[q] += m;
-            mesh.quads.volume[q] += t[k].volume;
-            const auto nodes = triangle_nodes(k);
-            const std::array<Vec2, 3> corners{x[nodes[0]], x[nodes[1]], x[nodes[2]]};
-            const auto share = element::lumped_masses<G>(t[k], corners, m);
-            for (int a = 0; a < 3; ++a) mesh.nodes.mass[mesh.quads.nodes[q][nodes[a]]] += share[a];
+            quads.mass[q] += m;
+            quads.volume[q] += t[k].volume;
+            // E4: lumped (row-sum) nodal masses.
+            const auto corners = triangle_nodes(k);
+            const auto share = element::lumped_masses<G>(t[k], {x[corners[0]], x[corners[1]], x[corners[2]]}, m);
+            for (int a = 0; a < 3; ++a) mesh.nodes.mass[quads.nodes[q][corners[a]]] += share[a];
         }
-        mesh.quads.length[q] = element::stable_length(x, t);
+        quads.length[q] = element::stable_length(x, t);
     }
 }
+
+}  // namespace
+
+void initialise_element_state(ElementMesh& mesh, const Scene& scene) {
+    dispatch_2d(mesh.geometry, [&](auto g) { initialise_state<decltype(g)>(mesh, scene); });
+}
+
+namespace {
 
 // Edges of quadrilaterals that no other quadrilateral shares (the boundary of each body's mesh).
 std::vector<std::array<NodeIndex, 2>> boundary_edges(const ElementQuads& quads) {
@@ -239,6 +265,7 @@ ElementMesh mesh_element_bodies(const Scene& scene) {
         dispatch_2d(scene.geometry, [&](auto g) { mesh_body<decltype(g)>(scene, b, mesh); });
     }
     mesh.boundary_edges = boundary_edges(mesh.quads);
+    initialise_element_state(mesh, scene);
     return mesh;
 }
 

@@ -747,7 +747,10 @@ void Simulation::Impl::build_phase_graph() {
     graph->add("totals", [this] {
         ++steps;
         node_steps += static_cast<double>(real);
-        if (elements) element_steps += static_cast<double>(elements->mesh().quads.size());
+        if (elements) {
+            node_steps += static_cast<double>(elements->mesh().nodes.size());
+            element_steps += static_cast<double>(elements->mesh().quads.size());
+        }
         sum_totals();
         dt_half = dt_next;
     });

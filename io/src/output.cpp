@@ -9,6 +9,9 @@
 
 #include <fmt/format.h>
 
+#include "gpa/engine/elements.hpp"
+#include "gpa/engine/measure.hpp"
+
 namespace gpa::io {
 
 namespace fs = std::filesystem;
@@ -59,7 +62,7 @@ HistoryWriter::HistoryWriter(const fs::path& file, const Totals& first, int dim)
     header += dim == 3 ? ",momentum_x_kg_m_s,momentum_y_kg_m_s,momentum_z_kg_m_s" : ",momentum_x_kg_m_s,momentum_z_kg_m_s";
     header += ",length_m,footprint_diameter_m";
     for (const auto& p : first.planes) header += fmt::format(",{0}_reaction_N,{0}_impulse_N_s", p.name.empty() ? "plane" : p.name);
-    header += ",real_nodes,ghost_nodes,variable_nodes,failed_nodes,neighbour_pairs\n";
+    header += ",real_nodes,ghost_nodes,variable_nodes,failed_nodes,neighbour_pairs,element_nodes,elements\n";
     std::fputs(header.c_str(), file_);
 }
 
@@ -77,7 +80,8 @@ void HistoryWriter::write(const Totals& t) {
         const PlaneReport r = p < t.planes.size() ? t.planes[p] : PlaneReport{};
         row += fmt::format(",{:.9e},{:.9e}", r.reaction, r.impulse);
     }
-    row += fmt::format(",{},{},{},{},{}\n", t.real_nodes, t.ghost_nodes, t.variable_nodes, t.failed_nodes, t.pairs);
+    row += fmt::format(",{},{},{},{},{},{},{}\n", t.real_nodes, t.ghost_nodes, t.variable_nodes, t.failed_nodes, t.pairs,
+                       t.element_nodes, t.elements);
     if (std::fputs(row.c_str(), file_) < 0 || std::fflush(file_) != 0) {
         throw OutputError(fmt::format("writing '{}' failed: {}", path_.string(), std::strerror(errno)));
     }
@@ -178,6 +182,8 @@ void write_summary(const fs::path& file, const Simulation& sim, const RunSummary
     field("ghost_nodes", std::to_string(t.ghost_nodes));
     field("variable_nodes", std::to_string(t.variable_nodes));
     field("failed_nodes", std::to_string(t.failed_nodes));
+    field("element_nodes", std::to_string(t.element_nodes));
+    field("elements", std::to_string(t.elements));
     field("threads", std::to_string(sim.threads()));
     field("final", fmt::format("{{\"length_m\": {}, \"footprint_diameter_m\": {}, \"plastic_work_J\": {}}}",
                                json_number(t.length), json_number(t.footprint_diameter), json_number(t.plastic_work)));
@@ -213,10 +219,43 @@ void write_summary(const fs::path& file, const Simulation& sim, const RunSummary
     field("output_seconds", json_number(run.output_seconds));
     field("wall_seconds", json_number(run.wall_seconds));
     field("node_steps_per_second", json_number(stepping > 0.0 ? sim.node_steps() / stepping : 0.0));
+    field("element_steps_per_second", json_number(stepping > 0.0 ? sim.element_steps() / stepping : 0.0));
     field("snapshots", std::to_string(run.snapshots), true);
     j += "}\n";
     write_text_file(file, j);
 }
+
+namespace {
+
+// The outline of element bodies (measure.hpp, element rule: the nodes lie on the boundary): at
+// the height of every boundary node, the largest radius of the boundary edges that span that
+// height, interpolated along each edge.
+std::vector<std::pair<double, double>> element_outline(const ElementMesh& m, const PlaneSpec& plane, int across_axis,
+                                                       double centre, bool axisymmetric) {
+    const auto height = [&](NodeIndex i) { return plane.side * (m.nodes.position[plane.axis][i] - plane.position); };
+    const auto radius = [&](NodeIndex i) {
+        const double x = m.nodes.position[across_axis][i] - centre;
+        return measure::element_outline_radius(axisymmetric ? x : std::abs(x));
+    };
+    std::vector<double> heights;
+    for (const auto& e : m.boundary_edges) heights.push_back(height(e[0]));
+    std::sort(heights.begin(), heights.end());
+    heights.erase(std::unique(heights.begin(), heights.end()), heights.end());
+    std::vector<std::pair<double, double>> out;
+    for (double h : heights) {
+        double r = -1.0;
+        for (const auto& e : m.boundary_edges) {
+            const double h0 = height(e[0]), h1 = height(e[1]);
+            if (h < std::min(h0, h1) || h > std::max(h0, h1)) continue;
+            const double r0 = radius(e[0]), r1 = radius(e[1]);
+            r = std::max(r, h0 == h1 ? std::max(r0, r1) : r0 + (r1 - r0) * (h - h0) / (h1 - h0));
+        }
+        if (r >= 0.0) out.emplace_back(h, r);
+    }
+    return out;
+}
+
+}  // namespace
 
 void write_profile(const fs::path& file, const Simulation& sim) {
     const Scene& scene = sim.scene();
@@ -225,7 +264,8 @@ void write_profile(const fs::path& file, const Simulation& sim) {
     if (plane == scene.planes.end()) return;
     const NodeStore& n = sim.nodes();
     const std::size_t count = sim.real_count();
-    if (count == 0) return;
+    const ElementPart* elements = sim.elements();
+    if (count == 0 && !elements) return;
     const int dim = n.dim();
     // The horizontal axes: those other than the plane's normal.
     std::vector<int> across;
@@ -236,16 +276,34 @@ void write_profile(const fs::path& file, const Simulation& sim) {
     // centroid.
     const bool axisymmetric = scene.geometry == GeometryKind::Axisymmetric && plane->axis == 1;
     std::array<double, 3> centre{0, 0, 0};
+    std::string text = "height_m,radius_m\n";
+    if (elements) {
+        // Element bodies are 2D: one axis across the plane.
+        const ElementMesh& m = elements->mesh();
+        if (!axisymmetric) {
+            for (std::size_t i = 0; i < m.nodes.size(); ++i) centre[across[0]] += m.nodes.position[across[0]][i] / double(m.nodes.size());
+        }
+        double top = 0.0;
+        for (const auto& [h, r] : element_outline(m, *plane, across[0], centre[across[0]], axisymmetric)) {
+            text += fmt::format("{:.6e},{:.6e}\n", h, r);
+            top = std::max(top, h);
+        }
+        text += fmt::format("{:.6e},{:.6e}\n", top, 0.0);
+        write_text_file(file, text);
+        return;
+    }
     if (!axisymmetric) {
         for (std::size_t i = 0; i < count; ++i) {
             for (int c : across) centre[c] += n.position[c][i] / double(count);
         }
     }
-    double mean_d = 0.0, top = 0.0;
+    double mean_d = 0.0;
+    measure::Extent extent;
     for (std::size_t i = 0; i < count; ++i) {
         mean_d += n.diameter[i] / double(count);
-        top = std::max(top, plane->side * (n.position[plane->axis][i] - plane->position) + 0.5 * n.diameter[i]);
+        measure::add_particle(extent, plane->side * (n.position[plane->axis][i] - plane->position), 0.0, n.diameter[i], false);
     }
+    const double top = std::max(extent.length(), 0.0);
     const double bin = mean_d;  // one row of nodes: narrower bins hold only inner nodes every other time
     const std::size_t bins = static_cast<std::size_t>(std::ceil(top / bin)) + 1;
     std::vector<double> radius(bins, -1.0);
@@ -255,9 +313,8 @@ void write_profile(const fs::path& file, const Simulation& sim) {
         for (int c : across) r += (n.position[c][i] - centre[c]) * (n.position[c][i] - centre[c]);
         r = std::sqrt(r);
         const auto k = static_cast<std::size_t>(std::clamp(h / bin, 0.0, double(bins - 1)));
-        radius[k] = std::max(radius[k], r + 0.5 * n.diameter[i]);
+        radius[k] = std::max(radius[k], measure::particle_outline_radius(r, n.diameter[i]));
     }
-    std::string text = "height_m,radius_m\n";
     for (std::size_t k = 0; k < bins; ++k) {
         if (radius[k] >= 0.0) text += fmt::format("{:.6e},{:.6e}\n", (double(k) + 0.5) * bin, radius[k]);
     }

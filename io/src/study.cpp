@@ -12,6 +12,7 @@
 #include <fmt/format.h>
 
 #include "gpa/engine/bodies.hpp"
+#include "gpa/engine/elements.hpp"
 #include "gpa/engine/errors.hpp"
 #include "gpa/io/output.hpp"
 #include "gpa/io/svg_plot.hpp"
@@ -455,6 +456,9 @@ RunProbe::RunProbe(const Simulation& sim) {
         lift_off_ = first->lift_off;
     }
     for (std::size_t i = 0; i < sim.real_count(); ++i) mass_ += sim.nodes().mass[i];
+    if (const ElementPart* e = sim.elements()) {
+        for (double m : e->mesh().nodes.mass) mass_ += m;
+    }
     previous_time_ = sim.time();
 }
 

@@ -111,6 +111,14 @@ struct ElementMesh {
 // masses set. Throws InputError for a body that is not 2D or holds no cell.
 ElementMesh mesh_element_bodies(const Scene& scene);
 
+// Sets the state of an unloaded mesh from its node positions, as mesh_element_bodies does: the
+// triangles' masses rho V (rho from each body's material and initial mean stress), their initial
+// stress, pressure, sound speed and temperature, the lumped nodal masses (E4), and each
+// quadrilateral's mass, volume and stable length. For meshes built or moved by hand (the node
+// positions, velocities, bodies, materials, quadrilaterals and on_axis set). Throws InputError
+// naming the element when a triangle has no positive area.
+void initialise_element_state(ElementMesh& mesh, const Scene& scene);
+
 struct ElementOptions {
     bool mean_dilatation = true;  // false: each triangle's own volumetric rate (for the locking study)
     bool viscosity = true;        // the artificial viscosity of E9 with the solver's C_L, C_Q

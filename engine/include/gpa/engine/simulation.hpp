@@ -93,7 +93,8 @@ public:
     std::vector<PhaseTime> phase_times() const;
     // The names of the phases in this scene's graph, in order.
     std::vector<std::string> phases() const;
-    // Real node-steps processed so far (sum over steps of the real node count).
+    // Node-steps processed so far (sum over steps of the real particle nodes and the nodes of
+    // element bodies).
     double node_steps() const;
     // Element-steps (quadrilaterals times steps) processed so far.
     double element_steps() const;
