@@ -1,5 +1,6 @@
 #include "run.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <ctime>
@@ -11,6 +12,7 @@
 #include <spdlog/spdlog.h>
 
 #include "gpa/engine/bodies.hpp"
+#include "gpa/engine/elements.hpp"
 #include "gpa/engine/errors.hpp"
 #include "gpa/engine/simulation.hpp"
 #include "gpa/io/material_library.hpp"
@@ -173,8 +175,13 @@ int check_scene(const fs::path& file) {
         const auto block = body_lattice(scene, b);
         std::size_t count = 0;
         for (std::size_t i = 0; i < sim.real_count(); ++i) count += sim.nodes().body[i] == static_cast<int>(b);
-        fmt::print("  body \"{}\": {}, {} nodes, lattice spacing {:.4g} x {:.4g} mm\n", scene.bodies[b].name,
-                   scene.bodies[b].material, count, block.spacing[0] * 1e3, block.spacing[1] * 1e3);
+        std::string elements;
+        if (const ElementPart* e = sim.elements(); e && scene.bodies[b].discretisation == Discretisation::Elements) {
+            count = static_cast<std::size_t>(std::count(e->mesh().nodes.body.begin(), e->mesh().nodes.body.end(), static_cast<int>(b)));
+            elements = fmt::format(" ({} elements)", std::count(e->mesh().quads.body.begin(), e->mesh().quads.body.end(), static_cast<int>(b)));
+        }
+        fmt::print("  body \"{}\": {}, {} nodes{}, lattice spacing {:.4g} x {:.4g} mm\n", scene.bodies[b].name,
+                   scene.bodies[b].material, count, elements, block.spacing[0] * 1e3, block.spacing[1] * 1e3);
     }
     fmt::print("  first time step {:.3g} ns; phases: {}\n", sim.next_time_step() * 1e9, fmt::join(sim.phases(), ", "));
     return 0;

@@ -733,7 +733,7 @@ void Simulation::Impl::build_phase_graph() {
     graph->add("time step", [this] { time_step(); });
     if (particles) graph->add("forces", [this] { forces<G>(); });
     if (elements) graph->add("element forces", [this] { elements->compute_forces(); });
-    graph->add("integrate", [this] { integrate(0.5 * (dt_half + dt_next)); });
+    if (particles) graph->add("integrate", [this] { integrate(0.5 * (dt_half + dt_next)); });
     if (elements) graph->add("element integrate", [this] { elements->integrate(0.5 * (dt_half + dt_next), dt_next); });
     if (particles && scene.solver.smoothing != SmoothingMode::Off && scene.solver.smoothing_coefficient > 0.0) {
         graph->add("smoothing", [this] { smoothing<G>(); });
