@@ -150,9 +150,11 @@ ReturnResult radial_return(const Strength& strength, const Eigen::Matrix3d& tria
         if (!(trial_equivalent > y)) {
             return elastic;
         }
-        if (!(shear_modulus > 0.0) || t_star >= 1.0) return project(trial, trial_equivalent, y, 0.0);
-        const double increment = (trial_equivalent - y) / (3.0 * shear_modulus + h);
-        return project(trial, trial_equivalent, y + h * increment, increment);
+        if (!(shear_modulus > 0.0)) return project(trial, trial_equivalent, y, 0.0);
+        // Molten (Y = 0 whatever eps_p): the whole trial deviator returns, without hardening.
+        const double slope = t_star >= 1.0 ? 0.0 : h;
+        const double increment = (trial_equivalent - y) / (3.0 * shear_modulus + slope);
+        return project(trial, trial_equivalent, y + slope * increment, increment);
     }
 
     const auto& jc = std::get<JohnsonCookStrength>(strength);
