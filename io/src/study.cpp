@@ -430,8 +430,8 @@ double lattice_cell_size(const Scene& scene) {
 
 const std::vector<MetricInfo>& study_metrics() {
     static const std::vector<MetricInfo> metrics{
-        {"final_length", "m", "mm", 1e3, true, "length above the first rigid plane at the end"},
-        {"footprint_diameter", "m", "mm", 1e3, true, "width of the nodes within one diameter of the first rigid plane at the end"},
+        {"final_length", "m", "mm", 1e3, true, "length above the first rigid plane at the end (docs/measurement.md)"},
+        {"footprint_diameter", "m", "mm", 1e3, true, "width of the body on the first rigid plane at the end (docs/measurement.md)"},
         {"contact_time", "s", "us", 1e6, true, "time from the onset of contact with the first rigid plane to lift-off"},
         {"rebound_speed", "m/s", "m/s", 1.0, true, "|momentum along the plane normal| / mass after lift-off"},
         {"plastic_work", "J", "J", 1.0, true, "plastic work at the end"},
