@@ -24,6 +24,7 @@
 #include <fmt/format.h>
 
 #include "gpa/engine/elements.hpp"
+#include "bench_util.hpp"
 #include "gpa/engine/simulation.hpp"
 #include "gpa/io/scene_file.hpp"
 
@@ -34,12 +35,9 @@
 namespace {
 
 using Clock = std::chrono::steady_clock;
+using gpa::bench::median;
+using gpa::bench::parse_list;
 
-double median(std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    const std::size_t n = v.size();
-    return n == 0 ? 0.0 : (n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]));
-}
 
 gpa::Scene make_case(bool elements, double cells) {
     gpa::Scene scene = gpa::io::load_scene(std::filesystem::path(GPA_SOURCE_DIR) / "scenes/taylor-copper-190.toml");
@@ -73,21 +71,6 @@ struct Runner {
     }
 };
 
-std::vector<double> parse_list(const std::string& text) {
-    std::vector<double> out;
-    std::size_t start = 0;
-    while (start <= text.size()) {
-        const std::size_t comma = text.find(',', start);
-        const std::string item = text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
-        std::size_t used = 0;
-        const double v = std::stod(item, &used);
-        if (used != item.size() || !(v > 0.0)) throw std::invalid_argument("\"" + item + "\" is not a positive number");
-        out.push_back(v);
-        if (comma == std::string::npos) break;
-        start = comma + 1;
-    }
-    return out;
-}
 
 }  // namespace
 

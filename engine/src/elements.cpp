@@ -57,21 +57,6 @@ element::Deviator deviator_of(const ElementPoints& p, std::size_t i) {
     return {p.deviatoric_stress[0][i], p.deviatoric_stress[1][i], p.deviatoric_stress[2][i], p.deviatoric_stress[3][i]};
 }
 
-MaterialPointFields point_fields(ElementPoints& p) {
-    MaterialPointFields f;
-    for (int c = 0; c < 4; ++c) f.deviatoric_stress[c] = p.deviatoric_stress[c].data();
-    f.pressure = p.pressure.data();
-    f.internal_energy = p.internal_energy.data();
-    f.plastic_strain = p.plastic_strain.data();
-    f.temperature = p.temperature.data();
-    f.damage = p.damage.data();
-    f.failed = p.failed.data();
-    f.sound_speed = p.sound_speed.data();
-    f.plastic_work = p.plastic_work.data();
-    f.viscous_work = p.viscous_work.data();
-    return f;
-}
-
 std::string node_list(const ElementMesh& m, std::size_t q) {
     std::string out;
     for (int c = 0; c < 5; ++c) {
@@ -421,7 +406,7 @@ template <class G>
 void ElementPart::update_stress_in(double dt, std::size_t step, double time) {
     ElementMesh& m = mesh_;
     ElementPoints& p = m.points;
-    const MaterialPointFields fields = point_fields(p);
+    const MaterialPointFields fields = material_point_fields(p, 4);
     FirstPointFailure inverted, failed;  // indexed by triangle
     for (std::size_t mat = 0; mat < groups_.size(); ++mat) {
         const materials::Material& material = scene_.materials[mat];

@@ -57,21 +57,6 @@ constexpr std::size_t no_node = std::numeric_limits<std::size_t>::max();
 
 }  // namespace
 
-MaterialPointFields material_point_fields(NodeStore& nodes) {
-    MaterialPointFields f;
-    for (int c = 0; c < stress_components(nodes.dim()); ++c) f.deviatoric_stress[c] = nodes.deviatoric_stress[c].data();
-    f.pressure = nodes.pressure.data();
-    f.internal_energy = nodes.internal_energy.data();
-    f.plastic_strain = nodes.plastic_strain.data();
-    f.temperature = nodes.temperature.data();
-    f.damage = nodes.damage.data();
-    f.failed = nodes.failed.data();
-    f.sound_speed = nodes.sound_speed.data();
-    f.plastic_work = nodes.plastic_work.data();
-    f.viscous_work = nodes.viscous_work.data();
-    return f;
-}
-
 template <int D>
 materials::PointResult advance_material_point(const MaterialPointFields& f, std::size_t i,
                                               const materials::Material& material,
@@ -119,7 +104,7 @@ void update_stresses(NodeStore& nodes, std::size_t real_count, const std::vector
     constexpr int D = G::dim;
     std::atomic<std::size_t> collapsed{no_node};
     FirstPointFailure failure;  // taken only when a material update throws
-    const MaterialPointFields fields = material_point_fields(nodes);
+    const MaterialPointFields fields = material_point_fields(nodes, stress_components(nodes.dim()));
     for (std::size_t m = 0; m < groups.size(); ++m) {
         const materials::Material& material = materials.at(m);
         const auto& members = groups[m];

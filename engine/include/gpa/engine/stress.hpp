@@ -65,8 +65,23 @@ struct MaterialPointFields {
     double* viscous_work = nullptr;  // accumulated specific viscous work, J/kg
 };
 
-// The fields of the nodes of a store.
-MaterialPointFields material_point_fields(NodeStore& nodes);
+// The fields of any store that names them so (NodeStore, ElementPoints), with `components`
+// stress components (stress_components(dim)).
+template <class Store>
+MaterialPointFields material_point_fields(Store& store, int components) {
+    MaterialPointFields f;
+    for (int c = 0; c < components; ++c) f.deviatoric_stress[static_cast<std::size_t>(c)] = store.deviatoric_stress[static_cast<std::size_t>(c)].data();
+    f.pressure = store.pressure.data();
+    f.internal_energy = store.internal_energy.data();
+    f.plastic_strain = store.plastic_strain.data();
+    f.temperature = store.temperature.data();
+    f.damage = store.damage.data();
+    f.failed = store.failed.data();
+    f.sound_speed = store.sound_speed.data();
+    f.plastic_work = store.plastic_work.data();
+    f.viscous_work = store.viscous_work.data();
+    return f;
+}
 
 // Advances point i over the increment with materials::update_point and writes the new state back
 // (deviator, pressure, energy, plastic strain, temperature, damage, failure, sound speed, and the
