@@ -651,6 +651,43 @@ TEST(ElementBar, ContactTimeAndReboundSpeedWithinOnePercent) {
     EXPECT_LT(std::abs(sim.totals().energy_error), 1e-3);
 }
 
+// Contact with a rigid plane, frictionless: a bar that starts on the plane moving away from it
+// stays held with lift_off = false (its bottom nodes on the plane, the plane pulling: a negative
+// reaction, and the tangential motion free), and leaves it freely with lift-off allowed.
+TEST(ElementContact, HeldWithoutLiftOffAndFreeWithIt) {
+    for (bool lift_off : {false, true}) {
+        Scene s = testing::elastic_bar_on_plane(1e-3, 4e-3, 4, -5.0);  // moving up, away from the plane
+        s.bodies[0].discretisation = Discretisation::Elements;
+        s.planes[0].lift_off = lift_off;
+        s.stop.end_time = 0.0;
+        s.stop.max_steps = 200;
+        Simulation sim(s, 1);
+        double pulled = 0.0, longest = 0.0;
+        while (!sim.finished()) {
+            sim.step();
+            pulled = std::min(pulled, sim.totals().planes[0].reaction);
+            longest = std::max(longest, sim.totals().length);
+        }
+        const auto& m = sim.elements()->mesh();
+        double lowest = INFINITY;
+        for (std::size_t i = 0; i < m.nodes.size(); ++i) lowest = std::min(lowest, m.nodes.position[1][i]);
+        if (lift_off) {
+            EXPECT_EQ(pulled, 0.0);                         // the plane never pulls
+            EXPECT_NEAR(lowest, 5.0 * sim.time(), 1e-9);    // the whole bar moved off with its speed
+        } else {
+            EXPECT_LT(pulled, 0.0);                         // the plane holds the face back
+            EXPECT_EQ(lowest, 0.0);                         // the face stays on it, to the last bit
+            EXPECT_GT(longest, 4e-3 + 0.5 * 5.0 * 4e-3 / 5063.7);  // stretched by most of V L / c (1D: V L / c)
+            // Frictionless: the held face's nodes still spread or shrink radially (Poisson).
+            double outer = 0.0;
+            for (std::size_t i = 0; i < m.nodes.size(); ++i) {
+                if (m.nodes.position[1][i] == 0.0) outer = std::max(outer, m.nodes.position[0][i]);
+            }
+            EXPECT_NE(outer, 1e-3);
+        }
+    }
+}
+
 // The paper's Armco cylinder with elements, 10 elements across the radius, a short run: every
 // node and material point bit-identical on 1 and 2 threads (and 3, more threads than work).
 TEST(ElementThreads, AShortTaylorRunIsBitIdenticalOnOneTwoAndThreeThreads) {
