@@ -17,6 +17,7 @@
 #include <sys/statvfs.h>
 
 #include "gpa/engine/bodies.hpp"
+#include "gpa/engine/elements.hpp"
 #include "gpa/engine/errors.hpp"
 #include "gpa/engine/simulation.hpp"
 #include "gpa/engine/state_io.hpp"
@@ -89,8 +90,8 @@ private:
     double last_ = 0.0;
 };
 
-// A copy of the real nodes, written by a background task while the run goes on. A write that
-// failed is reported by the next call (write, write_marked or wait).
+// A copy of the real nodes and element bodies, written by a background task while the run goes on.
+// A write that failed is reported by the next call (write, write_marked or wait).
 class SnapshotWriter {
 public:
     explicit SnapshotWriter(fs::path folder) : series_(std::move(folder)) {}
@@ -102,19 +103,17 @@ public:
     }
     void write(const Simulation& sim) {
         wait();
-        NodeStore copy = sim.nodes();
-        copy.resize(sim.real_count());
-        const double t = sim.time();
-        pending_ = std::async(std::launch::async, [this, copy = std::move(copy), t] {
+        pending_ = std::async(std::launch::async, [this, snapshot = io::take_snapshot(sim)] {
             const auto t0 = std::chrono::steady_clock::now();
-            series_.write(copy, copy.size(), t);
+            series_.write(snapshot);
             seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         });
     }
     // A snapshot outside the schedule, written now (the run stops after it).
     std::string write_marked(const Simulation& sim, const std::string& label, const std::string& mark) {
         wait();
-        return series_.write_marked(sim.nodes(), sim.real_count(), sim.time(), label, mark);
+        const auto names = series_.write_marked(io::take_snapshot(sim), label, mark);
+        return names.empty() ? std::string() : names.front();
     }
     void wait() {
         if (pending_.valid()) pending_.get();
@@ -145,7 +144,7 @@ std::string encode(const RunState& s) {
     std::string out = "gpa-run-state 1\n";
     out += fmt::format("scene_file={}\noverwrite={}\nwall_seconds={:.17g}\noutput_seconds={:.17g}\nsnapshot_slot={:.17g}\n",
                        scene, s.overwrite ? 1 : 0, s.wall_seconds, s.output_seconds, s.snapshot_slot);
-    for (const auto& e : s.snapshots) out += fmt::format("snapshot={:.17g} {}\n", e.time, e.file);
+    for (const auto& e : s.snapshots) out += fmt::format("snapshot={:.17g} {} {}\n", e.time, e.part, e.file);
     return out;
 }
 
@@ -168,8 +167,11 @@ RunState decode(const std::string& text, const std::string& source) {
             else if (key == "snapshot_slot") s.snapshot_slot = std::stod(value);
             else if (key == "snapshot") {
                 const auto space = value.find(' ');
-                if (space == std::string::npos) throw std::invalid_argument(value);
-                s.snapshots.push_back({std::stod(value.substr(0, space)), value.substr(space + 1)});
+                const auto second = space == std::string::npos ? space : value.find(' ', space + 1);
+                if (second == std::string::npos) throw std::invalid_argument(value);
+                io::PvdEntry e{std::stod(value.substr(0, space)), value.substr(second + 1)};
+                e.part = std::stoi(value.substr(space + 1, second - space - 1));
+                s.snapshots.push_back(e);
             }
         } catch (const std::exception&) {
             throw CheckpointError(fmt::format("checkpoint {}: its run state is damaged at \"{}\"", source, line));
@@ -222,6 +224,7 @@ void check_disk(const Simulation& sim, const SnapshotSchedule& schedule, const f
 void print_report(const Simulation& sim) {
     const auto& t = sim.totals();
     fmt::print("  {} real nodes, {} steps, t = {:.4g} us ({})\n", t.real_nodes, t.step, t.time * 1e6, sim.stop_reason());
+    if (t.elements > 0) fmt::print("  {} elements, {} element nodes\n", t.elements, t.element_nodes);
     if (!t.planes.empty()) {
         fmt::print("  final length {:.4g} mm, footprint diameter {:.4g} mm\n", t.length * 1e3, t.footprint_diameter * 1e3);
     }
@@ -288,7 +291,9 @@ public:
             const bool stale = name == "summary.json" || name == "profile.csv" || entry.path().extension() == ".tmp";
             if ((snapshot && !kept) || stale) fs::remove(entry.path(), ec);
         }
-        snapshots_.series().restore(state_.snapshots, state_.snapshots.size());
+        snapshots_.series().restore(state_.snapshots, static_cast<std::size_t>(std::count_if(
+                                                          state_.snapshots.begin(), state_.snapshots.end(),
+                                                          [](const io::PvdEntry& e) { return e.part == 0; })));
         check_disk(sim_, schedule_, folder_.partial(),
                    state_.snapshots.empty() ? 0 : file_bytes(folder_.partial() / state_.snapshots.front().file));
     }
@@ -346,6 +351,7 @@ private:
     }
 
     void write_checkpoint(double wall_seconds) {
+        if (!sim_.can_checkpoint()) return;  // element bodies: said once at the start
         snapshots_.wait();  // the series on disk is the one the checkpoint lists
         RunState s = state_;
         s.scene_file = source_.label;
@@ -469,6 +475,9 @@ int fresh_run(const RunOptions& options) {
         spdlog::info("{}: {} nodes, {} thread{}, output in {}", scene.name.empty() ? "scene" : scene.name, sim.real_count(),
                      sim.threads(), sim.threads() == 1 ? "" : "s", folder.partial().string());
     }
+    if (!sim.can_checkpoint()) {
+        spdlog::warn("element bodies cannot be checkpointed yet: this run writes no checkpoint and cannot be resumed");
+    }
     RunState state;
     state.scene_file = source.label;
     state.overwrite = options.overwrite;
@@ -541,8 +550,13 @@ int check_scene(const fs::path& file, const MemoryLimit& memory) {
         const auto block = body_lattice(scene, b);
         std::size_t count = 0;
         for (std::size_t i = 0; i < sim.real_count(); ++i) count += sim.nodes().body[i] == static_cast<int>(b);
-        fmt::print("  body \"{}\": {}, {} nodes, lattice spacing {:.4g} x {:.4g} mm\n", scene.bodies[b].name,
-                   scene.bodies[b].material, count, block.spacing[0] * 1e3, block.spacing[1] * 1e3);
+        std::string elements;
+        if (const ElementPart* e = sim.elements(); e && scene.bodies[b].discretisation == Discretisation::Elements) {
+            count = static_cast<std::size_t>(std::count(e->mesh().nodes.body.begin(), e->mesh().nodes.body.end(), static_cast<int>(b)));
+            elements = fmt::format(" ({} elements)", std::count(e->mesh().quads.body.begin(), e->mesh().quads.body.end(), static_cast<int>(b)));
+        }
+        fmt::print("  body \"{}\": {}, {} nodes{}, lattice spacing {:.4g} x {:.4g} mm\n", scene.bodies[b].name,
+                   scene.bodies[b].material, count, elements, block.spacing[0] * 1e3, block.spacing[1] * 1e3);
     }
     fmt::print("  first time step {:.3g} ns; phases: {}\n", sim.next_time_step() * 1e9, fmt::join(sim.phases(), ", "));
     return 0;

@@ -268,7 +268,7 @@ int run_study(const StudyOptions& options) {
         try {
             sim = std::make_unique<Simulation>(p.scene, p.threads, options.memory);
             io::RunProbe probe(*sim);
-            c.nodes = sim->real_count();
+            c.nodes = sim->real_count() + sim->totals().element_nodes;
             c.threads = sim->threads();
             Progress progress(options.quiet || ::isatty(::fileno(stderr)) == 0);  // in place on a terminal, else silent
             const auto loop_start = std::chrono::steady_clock::now();

@@ -34,6 +34,7 @@
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
 
+#include "bench_util.hpp"
 #include "gpa/engine/simulation.hpp"
 #include "gpa/io/output.hpp"
 #include "gpa/io/scene_file.hpp"
@@ -45,12 +46,9 @@
 namespace {
 
 using Clock = std::chrono::steady_clock;
+using gpa::bench::median;
+using gpa::bench::parse_list;
 
-double median(std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    const std::size_t n = v.size();
-    return n == 0 ? 0.0 : (n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]));
-}
 
 // The bar of scenes/taylor-copper-190.toml in the geometry and connectivity of `name`, with a
 // spacing that gives about `nodes` nodes.
@@ -156,21 +154,6 @@ double triad_bandwidth(int threads, std::size_t n) {
     return median(rates);
 }
 
-std::vector<double> parse_list(const std::string& text) {
-    std::vector<double> out;
-    std::size_t start = 0;
-    while (start <= text.size()) {
-        const std::size_t comma = text.find(',', start);
-        const std::string item = text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
-        std::size_t used = 0;
-        const double v = std::stod(item, &used);
-        if (used != item.size() || !(v > 0.0)) throw std::invalid_argument("\"" + item + "\" is not a positive number");
-        out.push_back(v);
-        if (comma == std::string::npos) break;
-        start = comma + 1;
-    }
-    return out;
-}
 
 }  // namespace
 

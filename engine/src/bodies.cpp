@@ -117,11 +117,8 @@ LatticeBlock body_lattice(const Scene& scene, std::size_t index) {
     return block;
 }
 
-namespace {
-
-// The initial volumetric strain that puts the equation of state at pressure p (e = 0): the
-// mean stress of a body's initial stress. Bisection on eps_v in (-0.5, 1).
-double strain_for_pressure(const materials::Material& m, double p, const std::string& body) {
+// Bisection on eps_v in (-0.5, 1) (bodies.hpp).
+double initial_volumetric_strain(const materials::Material& m, double p, const std::string& body) {
     if (p == 0.0) return 0.0;
     const auto pressure_at = [&](double eps_v) {
         return materials::evaluate_eos(m.eos, m.density, m.density / (1.0 + eps_v), 0.0).pressure;
@@ -138,8 +135,6 @@ double strain_for_pressure(const materials::Material& m, double p, const std::st
     }
     return 0.5 * (lo + hi);
 }
-
-}  // namespace
 
 std::size_t add_body_nodes(NodeStore& nodes, const Scene& scene, std::size_t index, const std::vector<MirrorPlane>& mirrors) {
     const BodySpec& b = scene.bodies.at(index);
@@ -162,7 +157,7 @@ std::size_t add_body_nodes(NodeStore& nodes, const Scene& scene, std::size_t ind
     // Initial stress: deviator into s, mean stress into an initial compression.
     const auto& sig = b.initial_stress;
     const double mean = dim == 2 ? (sig[0] + sig[1] + sig[3]) / 3.0 : (sig[0] + sig[1] + sig[2]) / 3.0;
-    const double eps_v = strain_for_pressure(mat, -mean, b.name);
+    const double eps_v = initial_volumetric_strain(mat, -mean, b.name);
     for (std::size_t i = first; i < nodes.size(); ++i) {
         for (int c = 0; c < stress_components(dim); ++c) {
             const bool normal = dim == 2 ? (c != 2) : (c < 3);

@@ -175,6 +175,23 @@ void check_body(const Scene& scene, const BodySpec& b, std::size_t i) {
         }
     }
 
+    if (b.discretisation != Discretisation::Particles && b.discretisation != Discretisation::Elements) {
+        fail(fmt::format("{}.discretisation: unknown discretisation", label));
+    }
+    if (b.discretisation == Discretisation::Elements) {
+        if (dim != 2) {
+            fail(fmt::format("{}.discretisation = \"elements\": the element solver is 2D (axisymmetric or plane strain); "
+                             "a 3D body takes particles",
+                             label));
+        }
+        if (b.connectivity) {
+            fail(fmt::format("{}.connectivity applies to particle bodies only (this body is discretised by elements)", label));
+        }
+        if (b.lattice_neighbours != 0) {
+            fail(fmt::format("{}.lattice_neighbours applies to particle bodies only (this body is discretised by elements)",
+                             label));
+        }
+    }
     if (b.lattice_neighbours != 0) {
         const int n = b.lattice_neighbours;
         const bool valid = dim == 2 ? (n == 4 || n == 8) : (n == 6 || n == 18 || n == 26);
@@ -323,6 +340,14 @@ std::string_view name_of(ShapeKind s) {
     return "?";
 }
 
+std::string_view name_of(Discretisation d) {
+    switch (d) {
+        case Discretisation::Particles: return "particles";
+        case Discretisation::Elements: return "elements";
+    }
+    return "?";
+}
+
 bool is_round(ShapeKind s) { return s == ShapeKind::Cylinder || s == ShapeKind::Plate || s == ShapeKind::Sphere; }
 
 void validate_scene(const Scene& scene) {
@@ -349,6 +374,21 @@ void validate_scene(const Scene& scene) {
                 fail(fmt::format("{}: the name is already used by body[{}]", body_label(scene.bodies[i], i), j));
             }
         }
+    }
+
+    // Particle and element bodies in one scene would pass through each other: nothing couples the
+    // two kinds yet (the paper links them through shared boundary nodes; the engine keeps both in
+    // one step so that such a coupling can be added).
+    const auto elements = std::count_if(scene.bodies.begin(), scene.bodies.end(), [](const BodySpec& b) {
+        return b.discretisation == Discretisation::Elements;
+    });
+    if (elements > 0 && elements < static_cast<std::ptrdiff_t>(scene.bodies.size())) {
+        std::size_t p = 0, e = 0;
+        while (scene.bodies[p].discretisation != Discretisation::Particles) ++p;
+        while (scene.bodies[e].discretisation != Discretisation::Elements) ++e;
+        fail(fmt::format("{} is discretised by elements but {} by particles: a scene takes one kind for all its bodies "
+                         "(particle-element coupling is not implemented yet, so they would not interact)",
+                         body_label(scene.bodies[e], e), body_label(scene.bodies[p], p)));
     }
 
     for (std::size_t i = 0; i < scene.planes.size(); ++i) {

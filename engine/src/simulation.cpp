@@ -16,11 +16,13 @@
 #include "gpa/engine/bodies.hpp"
 #include "gpa/engine/colouring.hpp"
 #include "gpa/engine/drivers.hpp"
+#include "gpa/engine/elements.hpp"
 #include "gpa/engine/errors.hpp"
 #include "gpa/engine/ghosts.hpp"
 #include "gpa/engine/hourglass.hpp"
 #include "gpa/engine/kernels.hpp"
 #include "gpa/engine/lattice_check.hpp"
+#include "gpa/engine/measure.hpp"
 #include "gpa/engine/neighbours.hpp"
 #include "gpa/engine/parallel.hpp"
 #include "gpa/engine/smoothing.hpp"
@@ -37,9 +39,7 @@ constexpr std::size_t reduce_grain = 4096;  // fixed, so that every sum has one 
 struct Sums {
     double kinetic = 0.0, internal = 0.0, plastic = 0.0, viscous = 0.0;
     std::array<double, 3> momentum{0, 0, 0};
-    double length = -std::numeric_limits<double>::infinity();
-    double footprint_hi = -std::numeric_limits<double>::infinity();
-    double footprint_lo = std::numeric_limits<double>::infinity();
+    measure::Extent extent;
     std::size_t variable = 0, failed = 0;
 
     Sums& operator+=(const Sums& o) {
@@ -48,9 +48,7 @@ struct Sums {
         plastic += o.plastic;
         viscous += o.viscous;
         for (int c = 0; c < 3; ++c) momentum[c] += o.momentum[c];
-        length = std::max(length, o.length);
-        footprint_hi = std::max(footprint_hi, o.footprint_hi);
-        footprint_lo = std::min(footprint_lo, o.footprint_lo);
+        extent += o.extent;
         variable += o.variable;
         failed += o.failed;
         return *this;
@@ -102,6 +100,9 @@ struct Simulation::Impl {
     std::vector<double> largest_bond_q;  // per centre, the largest Q_ij of its pairs (for the time step)
     bool failed = false;                 // a phase threw: the state is half-updated
     std::unique_ptr<PhaseGraph> graph;
+    bool particles = true;                  // the scene has particle bodies (real > 0)
+    std::unique_ptr<ElementPart> elements;  // the element bodies, if any (elements.hpp)
+    double element_steps = 0.0;
 
     double time = 0.0;
     double dt_half = 0.0;  // dt^{n+1/2}: the step from t^n to t^{n+1}
@@ -154,6 +155,7 @@ struct Simulation::Impl {
     template <class G>
     void smoothing();
     void sum_totals();
+    measure::Extent element_extent(const GhostPlane& plane, bool axisymmetric) const;
     void regroup_materials();
 };
 
@@ -174,10 +176,15 @@ void Simulation::Impl::setup() {
     reaction.assign(rigid_planes.size(), 0.0);
     const auto mirrors = ghosts.mirror_planes();
     for (std::size_t b = 0; b < scene.bodies.size(); ++b) {
-        add_body_nodes(nodes, scene, b, mirrors);
+        if (scene.bodies[b].discretisation == Discretisation::Particles) add_body_nodes(nodes, scene, b, mirrors);
         body_mode.push_back(scene.bodies[b].connectivity.value_or(scene.solver.connectivity));
     }
     real = nodes.size();
+    particles = real > 0;
+    if (std::any_of(scene.bodies.begin(), scene.bodies.end(),
+                    [](const BodySpec& b) { return b.discretisation == Discretisation::Elements; })) {
+        elements = std::make_unique<ElementPart>(scene, mesh_element_bodies(scene), element_options(scene));
+    }
     validate_nodes(nodes, 0, real);
     // Nodes of variable-connectivity bodies never read their lattice lists: drop them (memory).
     const auto drop_variable_rows = [&](CompressedRows& rows, std::vector<std::uint8_t>* tags) {
@@ -202,7 +209,7 @@ void Simulation::Impl::setup() {
     // neighbours, which exist when the body starts on the plane; a fixed or automatic body that
     // starts apart from a plane would pass through it.
     for (std::size_t b = 0; b < scene.bodies.size(); ++b) {
-        if (body_mode[b] == ConnectivityMode::Variable) continue;
+        if (body_mode[b] == ConnectivityMode::Variable || scene.bodies[b].discretisation != Discretisation::Particles) continue;
         for (std::size_t k = 0; k < scene.planes.size(); ++k) {
             const std::size_t bit = planes.size() - scene.planes.size() + k;
             bool touches = false;
@@ -224,7 +231,7 @@ void Simulation::Impl::setup() {
     }
     for (const auto& m : scene.materials) materials::validate(m);
     initialise_material_state(nodes, real, scene.materials);
-    if (scene.solver.reorder_interval > 0) reorder();
+    if (particles && scene.solver.reorder_interval > 0) reorder();
     regroup_materials();
     lists_constant = ghosts.empty() && !needs_search(nodes, real) &&
                      std::none_of(body_mode.begin(), body_mode.end(),
@@ -234,10 +241,12 @@ void Simulation::Impl::setup() {
     any_automatic = std::any_of(body_mode.begin(), body_mode.end(), [](ConnectivityMode m) { return m == ConnectivityMode::Automatic; });
 
     // Geometry, neighbours, geometry factors and forces at t = 0; then the first half step.
-    geometry<G>();
-    neighbours();
-    gradient<G>();
-    refresh_ghosts_and_plan();
+    if (particles) {
+        geometry<G>();
+        neighbours();
+        gradient<G>();
+        refresh_ghosts_and_plan();
+    }
     // The first step: dt from the initial state, velocities advance half a step (spec section 11).
     dt_half = 0.0;
     time_step();
@@ -245,8 +254,12 @@ void Simulation::Impl::setup() {
     const double kinetic_at_start = kinetic_half;
     totals.initial_kinetic_energy = kinetic_at_start;
     totals.initial_energy = kinetic_at_start + totals.internal_energy;
-    forces<G>();
+    if (particles) forces<G>();
     integrate(0.5 * dt_next);
+    if (elements) {
+        elements->compute_forces();
+        elements->integrate(0.5 * dt_next, dt_next);
+    }
     sum_totals();
     totals.kinetic_energy = kinetic_at_start;  // at t = 0: the initial velocities themselves
     totals.energy_error = 0.0;
@@ -568,6 +581,7 @@ void Simulation::Impl::time_step() {
             return best;
         },
         [](double x, double y) { return std::isnan(x) || std::isnan(y) ? std::nan("") : std::min(x, y); });
+    const double element_limit = elements ? elements->stable_time_step() : std::numeric_limits<double>::infinity();
     if (std::isnan(limit)) {
         for (std::size_t i = 0; i < real; ++i) {
             const double local = nodes.stable_length[i] / nodes.sound_speed[i];
@@ -581,7 +595,7 @@ void Simulation::Impl::time_step() {
         }
         throw NumericalError(fmt::format("the stable time step is not a number at t = {} s", time));
     }
-    double dt = scene.solver.cfl * limit;
+    double dt = scene.solver.cfl * std::min(limit, element_limit);
     if (dt_half > 0.0) dt = std::min(dt, scene.solver.time_step_growth * dt_half);
     dt = std::min(dt, scene.solver.max_time_step);
     // Land on the end time instead of stepping past it (unless only a sliver would remain).
@@ -692,37 +706,44 @@ void Simulation::Impl::sum_totals() {
                 acc.variable += nodes.connectivity[i] == Connectivity::Variable;
                 acc.failed += nodes.failed[i] != 0;
                 if (plane) {
-                    const double dist = plane->distance(nodes.position[plane->axis][i]);
-                    const double half = 0.5 * nodes.diameter[i];
-                    acc.length = std::max(acc.length, dist + half);
-                    if (dist < nodes.diameter[i]) {
-                        // Width across the plane's first other axis (radius x in axisymmetric geometry).
-                        const int across = plane->axis == 0 ? 1 : 0;
-                        const double x = nodes.position[across][i];
-                        acc.footprint_hi = std::max(acc.footprint_hi, x + half);
-                        // On the axis of an axisymmetric body the width is twice the radius.
-                        acc.footprint_lo = std::min(acc.footprint_lo, axisymmetric && across == 0 ? -(x + half) : x - half);
-                    }
+                    // Width across the plane's first other axis (radius x in axisymmetric geometry).
+                    const int across = plane->axis == 0 ? 1 : 0;
+                    measure::add_particle(acc.extent, plane->distance(nodes.position[plane->axis][i]),
+                                          nodes.position[across][i], nodes.diameter[i], axisymmetric && across == 0);
                 }
             }
             return acc;
         },
         [](Sums x, const Sums& y) { return x += y; });
+    Sums all = s;
+    double element_boundary_work = 0.0;
+    if (elements) {
+        const ElementPart::Sums e = elements->sums();
+        all.kinetic += e.kinetic;
+        all.internal += e.internal;
+        all.plastic += e.plastic;
+        all.viscous += e.viscous;
+        for (int c = 0; c < 2; ++c) all.momentum[c] += e.momentum[c];
+        element_boundary_work = elements->boundary_work();
+        if (plane) all.extent += element_extent(*plane, axisymmetric);
+    }
     // Kinetic energy at an integer time: the mean of the half steps around it (spec section 11).
-    totals.kinetic_energy = 0.5 * (kinetic_half + s.kinetic);
-    kinetic_half = s.kinetic;
-    totals.internal_energy = s.internal;
-    totals.plastic_work = s.plastic;
-    totals.viscous_work = s.viscous;
+    totals.kinetic_energy = 0.5 * (kinetic_half + all.kinetic);
+    kinetic_half = all.kinetic;
+    totals.internal_energy = all.internal;
+    totals.plastic_work = all.plastic;
+    totals.viscous_work = all.viscous;
     totals.hourglass_work = hourglass_work;
-    totals.boundary_work = boundary_work;
-    totals.momentum = s.momentum;
+    totals.boundary_work = boundary_work + element_boundary_work;
+    totals.momentum = all.momentum;
     totals.time = time;
     totals.time_step = dt_half;
     totals.step = steps;
-    totals.length = plane ? s.length : 0.0;
-    totals.footprint_diameter = plane && s.footprint_hi > s.footprint_lo ? s.footprint_hi - s.footprint_lo : 0.0;
+    totals.length = plane ? all.extent.length() : 0.0;
+    totals.footprint_diameter = plane ? all.extent.footprint() : 0.0;
     totals.real_nodes = real;
+    totals.element_nodes = elements ? elements->mesh().nodes.size() : 0;
+    totals.elements = elements ? elements->mesh().quads.size() : 0;
     totals.ghost_nodes = nodes.size() - real;
     totals.variable_nodes = s.variable;
     totals.failed_nodes = s.failed;
@@ -730,7 +751,9 @@ void Simulation::Impl::sum_totals() {
     totals.neighbour_searches = searches;
     totals.planes.clear();
     for (std::size_t k = 0; k < rigid_planes.size(); ++k) {
-        totals.planes.push_back({ghosts.planes()[rigid_planes[k]].name, reaction[k], impulse[k]});
+        const double element_reaction = elements ? elements->reactions()[k] : 0.0;
+        const double element_impulse = elements ? elements->impulses()[k] : 0.0;
+        totals.planes.push_back({ghosts.planes()[rigid_planes[k]].name, reaction[k] + element_reaction, impulse[k] + element_impulse});
     }
     if (totals.initial_energy != 0.0) {
         totals.energy_error = (totals.kinetic_energy + totals.internal_energy + totals.boundary_work - totals.initial_energy) /
@@ -738,36 +761,71 @@ void Simulation::Impl::sum_totals() {
     }
 }
 
+measure::Extent Simulation::Impl::element_extent(const GhostPlane& plane, bool axisymmetric) const {
+    // The element rule of measure.hpp: nodes lie on the boundary (no d/2), "on the plane" within
+    // the face tolerance of the node's body.
+    const ElementMesh& m = elements->mesh();
+    const int across = plane.axis == 0 ? 1 : 0;
+    return tbb::parallel_reduce(
+        tbb::blocked_range<std::size_t>(0, m.nodes.size(), reduce_grain), measure::Extent{},
+        [&](const tbb::blocked_range<std::size_t>& r, measure::Extent acc) {
+            for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                const double spacing = m.body_spacing[static_cast<std::size_t>(m.nodes.body[i])];
+                measure::add_element_node(acc, plane.distance(m.nodes.position[plane.axis][i]), m.nodes.position[across][i],
+                                          measure::element_face_tolerance(spacing), axisymmetric && across == 0);
+            }
+            return acc;
+        },
+        [](measure::Extent x, const measure::Extent& y) { return x += y; });
+}
+
 template <class G>
 void Simulation::Impl::build_phase_graph() {
     graph = std::make_unique<PhaseGraph>();
-    // The step, as drawn in simulation.hpp; bracketed phases only where the scene needs them.
-    graph->add("move", [this] { move(); });
-    if (scene.solver.reorder_interval > 0) {
-        graph->add("reorder", [this] {
-            if (steps % scene.solver.reorder_interval == 0 && steps > 0) reorder();
+    // The step, as drawn in simulation.hpp; bracketed phases only where the scene needs them, the
+    // particle phases only with particle bodies and the element phases only with element bodies.
+    if (particles) graph->add("move", [this] { move(); });
+    if (elements) {
+        graph->add("element move", [this] {
+            elements->move(dt_half);
+            if (!particles) time += dt_half;
         });
     }
-    graph->add("geometry", [this] { geometry<G>(); });
-    graph->add("neighbours", [this] { neighbours(); });
-    graph->add("gradient", [this] { gradient<G>(); });
-    graph->add("stress", [this] { stress<G>(); });
-    graph->add("plan", [this] { refresh_ghosts_and_plan(); });
+    if (particles) {
+        if (scene.solver.reorder_interval > 0) {
+            graph->add("reorder", [this] {
+                if (steps % scene.solver.reorder_interval == 0 && steps > 0) reorder();
+            });
+        }
+        graph->add("geometry", [this] { geometry<G>(); });
+        graph->add("neighbours", [this] { neighbours(); });
+        graph->add("gradient", [this] { gradient<G>(); });
+        graph->add("stress", [this] { stress<G>(); });
+    }
+    if (elements) graph->add("element stress", [this] { elements->update_stress(dt_half, steps + 1, time); });
+    if (particles) graph->add("plan", [this] { refresh_ghosts_and_plan(); });
     graph->add("time step", [this] { time_step(); });
-    graph->add("forces", [this] { forces<G>(); });
-    graph->add("integrate", [this] { integrate(0.5 * (dt_half + dt_next)); });
-    if (scene.solver.smoothing != SmoothingMode::Off && scene.solver.smoothing_coefficient > 0.0) {
+    if (particles) graph->add("forces", [this] { forces<G>(); });
+    if (elements) graph->add("element forces", [this] { elements->compute_forces(); });
+    if (particles) graph->add("integrate", [this] { integrate(0.5 * (dt_half + dt_next)); });
+    if (elements) graph->add("element integrate", [this] { elements->integrate(0.5 * (dt_half + dt_next), dt_next); });
+    if (particles && scene.solver.smoothing != SmoothingMode::Off && scene.solver.smoothing_coefficient > 0.0) {
         graph->add("smoothing", [this] { smoothing<G>(); });
     }
     // Switching last: a node that switches takes its new rule from the next geometry on, so that
     // its strain rates and forces always use one rule (spec section 2).
     // (Fixed bodies need it too: it checks their lattice cells.)
-    if (std::any_of(body_mode.begin(), body_mode.end(), [](ConnectivityMode m) { return m != ConnectivityMode::Variable; })) {
+    if (particles &&
+        std::any_of(body_mode.begin(), body_mode.end(), [](ConnectivityMode m) { return m != ConnectivityMode::Variable; })) {
         graph->add("switching", [this] { switching(); });
     }
     graph->add("totals", [this] {
         ++steps;
         node_steps += static_cast<double>(real);
+        if (elements) {
+            node_steps += static_cast<double>(elements->mesh().nodes.size());
+            element_steps += static_cast<double>(elements->mesh().quads.size());
+        }
         sum_totals();
         dt_half = dt_next;
     });
@@ -852,6 +910,8 @@ int Simulation::threads() const { return impl_->threads.threads(); }
 std::vector<PhaseTime> Simulation::phase_times() const { return impl_->graph->times(); }
 std::vector<std::string> Simulation::phases() const { return impl_->graph->names(); }
 double Simulation::node_steps() const { return impl_->node_steps; }
+double Simulation::element_steps() const { return impl_->element_steps; }
+const ElementPart* Simulation::elements() const { return impl_->elements.get(); }
 const CompressedRows& Simulation::neighbour_lists() const { return impl_->lists; }
 
 // --- limits, failure reports and checkpoints ----------------------------------------------
@@ -1152,7 +1212,13 @@ void Simulation::Impl::read_state(StateReader& in) {
     regroup_materials();
 }
 
+bool Simulation::can_checkpoint() const { return !impl_->elements; }
+
 void Simulation::save_checkpoint(std::ostream& out, std::string_view scene_fingerprint, std::string_view user_data) const {
+    if (!can_checkpoint()) {
+        throw InputError("Simulation::save_checkpoint: scenes with element bodies cannot be checkpointed yet (their state is not "
+                         "in the checkpoint format)");
+    }
     if (impl_->failed) throw NumericalError("Simulation::save_checkpoint: the last step failed and left the state half-updated");
     StateWriter w(out);
     w.bytes(checkpoint_magic, sizeof checkpoint_magic);

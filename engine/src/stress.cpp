@@ -1,9 +1,9 @@
 #include "gpa/engine/stress.hpp"
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <limits>
-#include <mutex>
 #include <string>
 
 #include <fmt/format.h>
@@ -28,11 +28,11 @@ Eigen::Matrix3d full_velocity_gradient(const NodeStore& nodes, std::size_t i) {
 
 namespace {
 
-// NodeStore stress order <-> the materials' (xx, yy, zz, yz, xz, xy). In 2D the materials'
-// axes are (x, z, out-of-plane), so the in-plane shear xz of the store is their "xy".
+// Stress order of geometry.hpp <-> the materials' (xx, yy, zz, yz, xz, xy). In 2D the materials'
+// axes are (x, z, out-of-plane), so the in-plane shear xz of the engine is their "xy".
 template <int D>
-materials::Sym3 to_material(const NodeStore& n, std::size_t i) {
-    const auto& s = n.deviatoric_stress;
+materials::Sym3 to_material(const MaterialPointFields& f, std::size_t i) {
+    const auto& s = f.deviatoric_stress;
     if constexpr (D == 2) {
         return {s[0][i], s[1][i], s[3][i], 0.0, 0.0, s[2][i]};
     } else {
@@ -41,8 +41,8 @@ materials::Sym3 to_material(const NodeStore& n, std::size_t i) {
 }
 
 template <int D>
-void from_material(NodeStore& n, std::size_t i, const materials::Sym3& m) {
-    auto& s = n.deviatoric_stress;
+void from_material(const MaterialPointFields& f, std::size_t i, const materials::Sym3& m) {
+    const auto& s = f.deviatoric_stress;
     if constexpr (D == 2) {
         s[0][i] = m[0];
         s[1][i] = m[1];
@@ -57,14 +57,54 @@ constexpr std::size_t no_node = std::numeric_limits<std::size_t>::max();
 
 }  // namespace
 
+template <int D>
+materials::PointResult advance_material_point(const MaterialPointFields& f, std::size_t i,
+                                              const materials::Material& material,
+                                              const materials::PointIncrement& increment) {
+    materials::PointState state;
+    state.deviatoric_stress = to_material<D>(f, i);
+    state.pressure = f.pressure[i];
+    state.specific_internal_energy = f.internal_energy[i];
+    state.plastic_strain = f.plastic_strain[i];
+    state.temperature = f.temperature[i];
+    state.damage = f.damage[i];
+    state.failed = f.failed[i] != 0;
+    const materials::PointResult result = materials::update_point(material, state, increment);
+    from_material<D>(f, i, state.deviatoric_stress);
+    f.pressure[i] = state.pressure;
+    f.internal_energy[i] = state.specific_internal_energy;
+    f.plastic_strain[i] = state.plastic_strain;
+    f.temperature[i] = state.temperature;
+    f.damage[i] = state.damage;
+    f.failed[i] = state.failed ? 1 : 0;
+    f.sound_speed[i] = result.sound_speed;
+    f.plastic_work[i] += result.plastic_work;
+    f.viscous_work[i] += result.viscous_work;
+    return result;
+}
+
+InitialPointState initial_material_point(const materials::Material& material, double density,
+                                         double specific_internal_energy) {
+    const auto eos = materials::evaluate_eos(material.eos, material.density, density, specific_internal_energy);
+    const double k = std::max(eos.bulk_modulus, 0.0);
+    return {eos.pressure, std::sqrt((k + 4.0 * material.shear_modulus / 3.0) / density)};
+}
+
+void FirstPointFailure::record(std::size_t index, std::string message) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    if (index < index_) {
+        index_ = index;
+        message_ = std::move(message);
+    }
+}
+
 template <class G>
 void update_stresses(NodeStore& nodes, std::size_t real_count, const std::vector<materials::Material>& materials,
                      const std::vector<std::vector<NodeIndex>>& groups, double dt, const StressPhaseOptions& options) {
     constexpr int D = G::dim;
     std::atomic<std::size_t> collapsed{no_node};
-    std::mutex failure_mutex;  // taken only when a material update throws
-    std::size_t failed_node = no_node;
-    std::string failure;
+    FirstPointFailure failure;  // taken only when a material update throws
+    const MaterialPointFields fields = material_point_fields(nodes, stress_components(nodes.dim()));
     for (std::size_t m = 0; m < groups.size(); ++m) {
         const materials::Material& material = materials.at(m);
         const auto& members = groups[m];
@@ -89,14 +129,6 @@ void update_stresses(NodeStore& nodes, std::size_t real_count, const std::vector
                                          ? nodal_viscosity(rate, density_new, nodes.sound_speed[i], nodes.smallest_h[i],
                                                            options.viscosity_linear, options.viscosity_quadratic)
                                          : 0.0;
-                materials::PointState state;
-                state.deviatoric_stress = to_material<D>(nodes, i);
-                state.pressure = nodes.pressure[i];
-                state.specific_internal_energy = nodes.internal_energy[i];
-                state.plastic_strain = nodes.plastic_strain[i];
-                state.temperature = nodes.temperature[i];
-                state.damage = nodes.damage[i];
-                state.failed = nodes.failed[i] != 0;
                 materials::PointIncrement inc;
                 inc.velocity_gradient = full_velocity_gradient<G>(nodes, i);
                 inc.dt = dt;
@@ -105,38 +137,23 @@ void update_stresses(NodeStore& nodes, std::size_t real_count, const std::vector
                 inc.viscous_pressure_old = nodes.viscous_pressure[i];
                 inc.viscous_pressure_new = q_new;
                 inc.failure_enabled = options.failure;
-                materials::PointResult result;
                 try {
-                    result = materials::update_point(material, state, inc);
+                    advance_material_point<D>(fields, i, material, inc);
                 } catch (const std::exception& e) {
-                    const std::lock_guard<std::mutex> lock(failure_mutex);
-                    if (i < failed_node) {
-                        failed_node = i;
-                        failure = e.what();
-                    }
+                    failure.record(i, e.what());
                     continue;
                 }
-                from_material<D>(nodes, i, state.deviatoric_stress);
                 nodes.volumetric_strain[i] = eps_v;
                 nodes.volume[i] = volume;
                 nodes.viscous_pressure[i] = q_new;
-                nodes.pressure[i] = state.pressure;
-                nodes.internal_energy[i] = state.specific_internal_energy;
-                nodes.plastic_strain[i] = state.plastic_strain;
-                nodes.temperature[i] = state.temperature;
-                nodes.damage[i] = state.damage;
-                nodes.failed[i] = state.failed ? 1 : 0;
-                nodes.sound_speed[i] = result.sound_speed;
-                nodes.plastic_work[i] += result.plastic_work;
-                nodes.viscous_work[i] += result.viscous_work;
             }
         });
     }
-    if (failed_node != no_node) {
-        const std::size_t i = failed_node;
+    if (failure.any()) {
+        const std::size_t i = failure.index();
         throw NumericalError(fmt::format("node {} at ({:.6g}, {:.6g}) m, material \"{}\", t-step {:.3g} s: {}", i,
                                          nodes.position[0][i], nodes.position[1][i],
-                                         materials.at(static_cast<std::size_t>(nodes.material[i])).name, dt, failure),
+                                         materials.at(static_cast<std::size_t>(nodes.material[i])).name, dt, failure.message()),
                              i, "stress (material point update)");
     }
     if (const std::size_t i = collapsed.load(); i != no_node) {
@@ -153,11 +170,9 @@ void update_stresses(NodeStore& nodes, std::size_t real_count, const std::vector
 void initialise_material_state(NodeStore& nodes, std::size_t real_count, const std::vector<materials::Material>& materials) {
     for (std::size_t i = 0; i < real_count; ++i) {
         const auto& m = materials.at(static_cast<std::size_t>(nodes.material[i]));
-        const double density = nodes.mass[i] / nodes.volume[i];
-        const auto eos = materials::evaluate_eos(m.eos, m.density, density, nodes.internal_energy[i]);
-        nodes.pressure[i] = eos.pressure;
-        const double k = std::max(eos.bulk_modulus, 0.0);
-        nodes.sound_speed[i] = std::sqrt((k + 4.0 * m.shear_modulus / 3.0) / density);
+        const InitialPointState start = initial_material_point(m, nodes.mass[i] / nodes.volume[i], nodes.internal_energy[i]);
+        nodes.pressure[i] = start.pressure;
+        nodes.sound_speed[i] = start.sound_speed;
         nodes.temperature[i] = m.room_temperature;
     }
 }
@@ -171,5 +186,9 @@ template void update_stresses<ThreeD>(NodeStore&, std::size_t, const std::vector
 template Eigen::Matrix3d full_velocity_gradient<PlaneStrain>(const NodeStore&, std::size_t);
 template Eigen::Matrix3d full_velocity_gradient<Axisymmetric>(const NodeStore&, std::size_t);
 template Eigen::Matrix3d full_velocity_gradient<ThreeD>(const NodeStore&, std::size_t);
+template materials::PointResult advance_material_point<2>(const MaterialPointFields&, std::size_t, const materials::Material&,
+                                                          const materials::PointIncrement&);
+template materials::PointResult advance_material_point<3>(const MaterialPointFields&, std::size_t, const materials::Material&,
+                                                          const materials::PointIncrement&);
 
 }  // namespace gpa

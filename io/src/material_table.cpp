@@ -152,7 +152,7 @@ m::EquationOfState read_eos(const TableReader& material, const m::EquationOfStat
 m::Strength read_strength(const TableReader& material, const m::Strength* base) {
     const std::vector<ModelChoice<m::Strength>> choices{
         {"elastic", m::ElasticStrength{}, {"model"}},
-        {"von-mises", m::VonMisesStrength{}, {"model", "yield_stress"}},
+        {"von-mises", m::VonMisesStrength{}, {"model", "yield_stress", "hardening_modulus"}},
         {"johnson-cook", m::JohnsonCookStrength{}, {"model", "a", "b", "n", "c", "m", "reference_strain_rate"}},
     };
     const ModelNode node = model_node(material, "strength");
@@ -164,6 +164,7 @@ m::Strength read_strength(const TableReader& material, const m::Strength* base) 
     const TableReader& t = *table.reader;
     if (auto* vm = std::get_if<m::VonMisesStrength>(&strength)) {
         read_constant(t, "yield_stress", vm->yield_stress, D::Pressure, Limit::NonNegative, fresh);
+        read_constant(t, "hardening_modulus", vm->hardening_modulus, D::Pressure, Limit::NonNegative, false);
     } else if (auto* jc = std::get_if<m::JohnsonCookStrength>(&strength)) {
         read_constant(t, "a", jc->a, D::Pressure, Limit::NonNegative, fresh);
         read_constant(t, "b", jc->b, D::Pressure, Limit::NonNegative, fresh);

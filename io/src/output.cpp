@@ -5,12 +5,16 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <map>
 #include <system_error>
 
 #include <fcntl.h>
 #include <unistd.h>
 
 #include <fmt/format.h>
+
+#include "gpa/engine/elements.hpp"
+#include "gpa/engine/measure.hpp"
 
 namespace gpa::io {
 
@@ -71,7 +75,7 @@ std::string history_header(const Totals& first, int dim) {
     header += dim == 3 ? ",momentum_x_kg_m_s,momentum_y_kg_m_s,momentum_z_kg_m_s" : ",momentum_x_kg_m_s,momentum_z_kg_m_s";
     header += ",length_m,footprint_diameter_m";
     for (const auto& p : first.planes) header += fmt::format(",{0}_reaction_N,{0}_impulse_N_s", p.name.empty() ? "plane" : p.name);
-    header += ",real_nodes,ghost_nodes,variable_nodes,failed_nodes,neighbour_pairs\n";
+    header += ",real_nodes,ghost_nodes,variable_nodes,failed_nodes,neighbour_pairs,element_nodes,elements\n";
     return header;
 }
 
@@ -139,7 +143,8 @@ void HistoryWriter::write(const Totals& t) {
         const PlaneReport r = p < t.planes.size() ? t.planes[p] : PlaneReport{};
         row += fmt::format(",{:.9e},{:.9e}", r.reaction, r.impulse);
     }
-    row += fmt::format(",{},{},{},{},{}\n", t.real_nodes, t.ghost_nodes, t.variable_nodes, t.failed_nodes, t.pairs);
+    row += fmt::format(",{},{},{},{},{},{},{}\n", t.real_nodes, t.ghost_nodes, t.variable_nodes, t.failed_nodes, t.pairs,
+                       t.element_nodes, t.elements);
     append(row);
 }
 
@@ -154,13 +159,47 @@ std::string SnapshotSeries::write(const NodeStore& nodes, std::size_t count, dou
     return name;
 }
 
-std::string SnapshotSeries::write_marked(const NodeStore& nodes, std::size_t count, double time, const std::string& label,
-                                         const std::string& mark) {
-    const std::string name = fmt::format("{}_{}.vtp", stem_, label);
-    write_vtp(folder_ / name, nodes, count);
-    entries_.push_back({time, name, mark});
+Snapshot take_snapshot(const Simulation& sim) {
+    Snapshot s;
+    s.time = sim.time();
+    s.particles = sim.nodes();
+    s.particles.resize(sim.real_count());
+    if (const ElementPart* e = sim.elements()) s.elements = e->mesh();
+    return s;
+}
+
+std::vector<std::string> SnapshotSeries::write_parts(const Snapshot& snapshot, const std::string& suffix, const std::string& mark) {
+    std::vector<std::string> names;
+    int part = 0;
+    const auto add = [&](const std::string& name) {
+        PvdEntry e{snapshot.time, name};
+        e.name = mark;
+        e.part = part++;
+        entries_.push_back(e);
+        names.push_back(name);
+    };
+    if (snapshot.particles.size() > 0 || !snapshot.elements) {
+        const std::string name = fmt::format("{}_{}.vtp", stem_, suffix);
+        write_vtp(folder_ / name, snapshot.particles, snapshot.particles.size());
+        add(name);
+    }
+    if (snapshot.elements) {
+        const std::string name = fmt::format("elements_{}.vtu", suffix);
+        write_vtu(folder_ / name, *snapshot.elements);
+        add(name);
+    }
     write_pvd(folder_ / (stem_ + ".pvd"), entries_);
-    return name;
+    return names;
+}
+
+std::vector<std::string> SnapshotSeries::write(const Snapshot& snapshot) {
+    auto names = write_parts(snapshot, fmt::format("{:05d}", scheduled_), "");
+    ++scheduled_;
+    return names;
+}
+
+std::vector<std::string> SnapshotSeries::write_marked(const Snapshot& snapshot, const std::string& label, const std::string& mark) {
+    return write_parts(snapshot, label, mark);
 }
 
 void SnapshotSeries::restore(std::vector<PvdEntry> entries, std::size_t scheduled) {
@@ -227,6 +266,8 @@ void write_summary(const fs::path& file, const Simulation& sim, const RunSummary
     field("ghost_nodes", std::to_string(t.ghost_nodes));
     field("variable_nodes", std::to_string(t.variable_nodes));
     field("failed_nodes", std::to_string(t.failed_nodes));
+    field("element_nodes", std::to_string(t.element_nodes));
+    field("elements", std::to_string(t.elements));
     field("threads", std::to_string(sim.threads()));
     field("final", fmt::format("{{\"length_m\": {}, \"footprint_diameter_m\": {}, \"plastic_work_J\": {}}}",
                                json_number(t.length), json_number(t.footprint_diameter), json_number(t.plastic_work)));
@@ -263,10 +304,43 @@ void write_summary(const fs::path& file, const Simulation& sim, const RunSummary
     field("output_seconds", json_number(run.output_seconds));
     field("wall_seconds", json_number(run.wall_seconds));
     field("node_steps_per_second", json_number(stepping > 0.0 ? sim.node_steps() / stepping : 0.0));
+    field("element_steps_per_second", json_number(stepping > 0.0 ? sim.element_steps() / stepping : 0.0));
     field("snapshots", std::to_string(run.snapshots), true);
     j += "}\n";
     write_text_file(file, j);
 }
+
+namespace {
+
+// The outline of element bodies (measure.hpp, element rule: the nodes lie on the boundary): at
+// the height of every boundary node, the largest radius of the boundary edges that span that
+// height, interpolated along each edge.
+std::vector<std::pair<double, double>> element_outline(const ElementMesh& m, const PlaneSpec& plane, int across_axis,
+                                                       double centre, bool axisymmetric) {
+    const auto height = [&](NodeIndex i) { return plane.side * (m.nodes.position[plane.axis][i] - plane.position); };
+    const auto radius = [&](NodeIndex i) {
+        const double x = m.nodes.position[across_axis][i] - centre;
+        return measure::element_outline_radius(axisymmetric ? x : std::abs(x));
+    };
+    std::vector<double> heights;
+    for (const auto& e : m.boundary_edges) heights.push_back(height(e[0]));
+    std::sort(heights.begin(), heights.end());
+    heights.erase(std::unique(heights.begin(), heights.end()), heights.end());
+    std::vector<std::pair<double, double>> out;
+    for (double h : heights) {
+        double r = -1.0;
+        for (const auto& e : m.boundary_edges) {
+            const double h0 = height(e[0]), h1 = height(e[1]);
+            if (h < std::min(h0, h1) || h > std::max(h0, h1)) continue;
+            const double r0 = radius(e[0]), r1 = radius(e[1]);
+            r = std::max(r, h0 == h1 ? std::max(r0, r1) : r0 + (r1 - r0) * (h - h0) / (h1 - h0));
+        }
+        if (r >= 0.0) out.emplace_back(h, r);
+    }
+    return out;
+}
+
+}  // namespace
 
 void write_profile(const fs::path& file, const Simulation& sim) {
     const Scene& scene = sim.scene();
@@ -275,7 +349,8 @@ void write_profile(const fs::path& file, const Simulation& sim) {
     if (plane == scene.planes.end()) return;
     const NodeStore& n = sim.nodes();
     const std::size_t count = sim.real_count();
-    if (count == 0) return;
+    const ElementPart* elements = sim.elements();
+    if (count == 0 && !elements) return;
     const int dim = n.dim();
     // The horizontal axes: those other than the plane's normal.
     std::vector<int> across;
@@ -286,16 +361,34 @@ void write_profile(const fs::path& file, const Simulation& sim) {
     // centroid.
     const bool axisymmetric = scene.geometry == GeometryKind::Axisymmetric && plane->axis == 1;
     std::array<double, 3> centre{0, 0, 0};
+    std::string text = "height_m,radius_m\n";
+    if (elements) {
+        // Element bodies are 2D: one axis across the plane.
+        const ElementMesh& m = elements->mesh();
+        if (!axisymmetric) {
+            for (std::size_t i = 0; i < m.nodes.size(); ++i) centre[across[0]] += m.nodes.position[across[0]][i] / double(m.nodes.size());
+        }
+        double top = 0.0;
+        for (const auto& [h, r] : element_outline(m, *plane, across[0], centre[across[0]], axisymmetric)) {
+            text += fmt::format("{:.6e},{:.6e}\n", h, r);
+            top = std::max(top, h);
+        }
+        text += fmt::format("{:.6e},{:.6e}\n", top, 0.0);
+        write_text_file(file, text);
+        return;
+    }
     if (!axisymmetric) {
         for (std::size_t i = 0; i < count; ++i) {
             for (int c : across) centre[c] += n.position[c][i] / double(count);
         }
     }
-    double mean_d = 0.0, top = 0.0;
+    double mean_d = 0.0;
+    measure::Extent extent;
     for (std::size_t i = 0; i < count; ++i) {
         mean_d += n.diameter[i] / double(count);
-        top = std::max(top, plane->side * (n.position[plane->axis][i] - plane->position) + 0.5 * n.diameter[i]);
+        measure::add_particle(extent, plane->side * (n.position[plane->axis][i] - plane->position), 0.0, n.diameter[i], false);
     }
+    const double top = std::max(extent.length(), 0.0);
     const double bin = mean_d;  // one row of nodes: narrower bins hold only inner nodes every other time
     // Only the bins that hold nodes, at most one per node, however far apart the bodies are.
     std::map<double, double> radius;  // bin index (a whole number) -> largest extent
@@ -305,10 +398,10 @@ void write_profile(const fs::path& file, const Simulation& sim) {
         for (int c : across) r += (n.position[c][i] - centre[c]) * (n.position[c][i] - centre[c]);
         r = std::sqrt(r);
         const double k = std::floor(std::max(h / bin, 0.0));
-        const auto [it, added] = radius.try_emplace(k, r + 0.5 * n.diameter[i]);
-        if (!added) it->second = std::max(it->second, r + 0.5 * n.diameter[i]);
+        const double extent_r = measure::particle_outline_radius(r, n.diameter[i]);
+        const auto [it, added] = radius.try_emplace(k, extent_r);
+        if (!added) it->second = std::max(it->second, extent_r);
     }
-    std::string text = "height_m,radius_m\n";
     for (const auto& [k, r] : radius) text += fmt::format("{:.6e},{:.6e}\n", (k + 0.5) * bin, r);
     text += fmt::format("{:.6e},{:.6e}\n", top, 0.0);
     write_text_file(file, text);

@@ -30,6 +30,7 @@ const std::vector<std::string_view> scene_keys{
 const std::vector<std::string_view> body_keys{
     "name",    "shape",     "material", "origin",         "size",         "radius",            "diameter",
     "length",  "spacing",   "spacing_z", "velocity",      "initial_stress", "connectivity",    "lattice_neighbours",
+    "discretisation",
 };
 const std::vector<std::string_view> plane_keys{"name", "kind", "axis", "position", "side", "lift_off"};
 const std::vector<std::string_view> solver_keys{
@@ -243,6 +244,13 @@ BodySpec read_body(const Reporter& reporter, const toml::table& table, std::size
         b.velocity = to_vector3(*velocity);
     }
     if (r.has("initial_stress")) b.initial_stress = read_initial_stress(r, geometry);
+    if (const auto d = r.choice<Discretisation>("discretisation", {{"particles", Discretisation::Particles},
+                                                                  {"elements", Discretisation::Elements}})) {
+        b.discretisation = *d;
+        if (b.discretisation == Discretisation::Elements && dim == 3) {
+            r.fail_at("discretisation", "\"elements\" is 2D only (axisymmetric or plane strain); a 3D body takes particles");
+        }
+    }
     b.connectivity = r.choice<ConnectivityMode>("connectivity", connectivity_words);
     if (const auto n = r.whole_number("lattice_neighbours", 0, 26)) b.lattice_neighbours = static_cast<int>(*n);
     return b;

@@ -12,6 +12,7 @@
 #include <fmt/format.h>
 
 #include "gpa/engine/bodies.hpp"
+#include "gpa/engine/elements.hpp"
 #include "gpa/engine/errors.hpp"
 #include "gpa/io/output.hpp"
 #include "gpa/io/svg_plot.hpp"
@@ -87,6 +88,7 @@ const std::vector<ChoiceKey> choice_keys{
     {"normalisation", {"per-direction", "moment-matrix"}},
     {"viscosity", {"none", "nodal", "bond"}},
     {"smoothing", {"off", "tension", "everywhere"}},
+    {"discretisation", {"particles", "elements"}},
 };
 
 const std::vector<const char*> number_keys{
@@ -376,6 +378,16 @@ void apply_variant(const Variant& variant, Scene& scene) {
             o.viscosity = value == "none" ? ViscosityKind::None : value == "nodal" ? ViscosityKind::Nodal : ViscosityKind::Bond;
         } else if (key == "smoothing") {
             o.smoothing = value == "off" ? SmoothingMode::Off : value == "tension" ? SmoothingMode::Tension : SmoothingMode::Everywhere;
+        } else if (key == "discretisation") {
+            // Every body, meshed from the same shape at the same spacing; the particle-only body
+            // keys go, since they do not apply to element bodies.
+            for (auto& b : scene.bodies) {
+                b.discretisation = value == "elements" ? Discretisation::Elements : Discretisation::Particles;
+                if (b.discretisation == Discretisation::Elements) {
+                    b.connectivity.reset();
+                    b.lattice_neighbours = 0;
+                }
+            }
         } else {
             const double x = parse_quantity(value, Dimension::Dimensionless);
             if (key == "cfl") o.cfl = x;
@@ -419,8 +431,8 @@ double lattice_cell_size(const Scene& scene) {
 
 const std::vector<MetricInfo>& study_metrics() {
     static const std::vector<MetricInfo> metrics{
-        {"final_length", "m", "mm", 1e3, true, "length above the first rigid plane at the end"},
-        {"footprint_diameter", "m", "mm", 1e3, true, "width of the nodes within one diameter of the first rigid plane at the end"},
+        {"final_length", "m", "mm", 1e3, true, "length above the first rigid plane at the end (docs/measurement.md)"},
+        {"footprint_diameter", "m", "mm", 1e3, true, "width of the body on the first rigid plane at the end (docs/measurement.md)"},
         {"contact_time", "s", "us", 1e6, true, "time from the onset of contact with the first rigid plane to lift-off"},
         {"rebound_speed", "m/s", "m/s", 1.0, true, "|momentum along the plane normal| / mass after lift-off"},
         {"plastic_work", "J", "J", 1.0, true, "plastic work at the end"},
@@ -447,6 +459,9 @@ RunProbe::RunProbe(const Simulation& sim) {
         lift_off_ = first->lift_off;
     }
     for (std::size_t i = 0; i < sim.real_count(); ++i) mass_ += sim.nodes().mass[i];
+    if (const ElementPart* e = sim.elements()) {
+        for (double m : e->mesh().nodes.mass) mass_ += m;
+    }
     previous_time_ = sim.time();
 }
 

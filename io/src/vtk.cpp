@@ -10,19 +10,24 @@
 #include <fmt/format.h>
 
 #include "gpa/io/atomic_file.hpp"
+#include "vtk_appended.hpp"
 
 namespace gpa::io {
 
-double von_mises_stress(const NodeStore& nodes, std::size_t i) {
-    const auto& s = nodes.deviatoric_stress;
+double von_mises_stress(const std::array<double, 6>& s, int dim) {
     double ss = 0.0;
-    if (nodes.dim() == 2) {
-        ss = s[0][i] * s[0][i] + s[1][i] * s[1][i] + s[3][i] * s[3][i] + 2.0 * s[2][i] * s[2][i];
+    if (dim == 2) {
+        ss = s[0] * s[0] + s[1] * s[1] + s[3] * s[3] + 2.0 * s[2] * s[2];
     } else {
-        ss = s[0][i] * s[0][i] + s[1][i] * s[1][i] + s[2][i] * s[2][i] +
-             2.0 * (s[3][i] * s[3][i] + s[4][i] * s[4][i] + s[5][i] * s[5][i]);
+        ss = s[0] * s[0] + s[1] * s[1] + s[2] * s[2] + 2.0 * (s[3] * s[3] + s[4] * s[4] + s[5] * s[5]);
     }
     return std::sqrt(1.5 * ss);
+}
+
+double von_mises_stress(const NodeStore& nodes, std::size_t i) {
+    std::array<double, 6> s{};
+    for (int c = 0; c < stress_components(nodes.dim()); ++c) s[c] = nodes.deviatoric_stress[c][i];
+    return von_mises_stress(s, nodes.dim());
 }
 
 namespace {
@@ -61,61 +66,30 @@ void write_vtp(const std::filesystem::path& path, const NodeStore& nodes, std::s
     };
     const auto positions = vector_field(nodes, nodes.position);
 
+    detail::AppendedBlocks data;
+    std::vector<std::uint64_t> offsets;
+    for (const auto& a : arrays) offsets.push_back(data.add_float(count, a.components, a.value));
+    const std::uint64_t points = data.add_float(count, 3, positions);
+    const std::uint64_t connectivity = data.add_int64(count, [](std::size_t i) { return static_cast<std::int64_t>(i); });
+    const std::uint64_t vertex_ends = data.add_int64(count, [](std::size_t i) { return static_cast<std::int64_t>(i + 1); });
+
     write_file_atomically(path, [&](std::ofstream& out) {
-        std::uint64_t offset = 0;
-        const auto block_bytes = [&](int components) { return 8 + 8 * static_cast<std::uint64_t>(components) * count; };
         out << "<?xml version=\"1.0\"?>\n"
             << "<VTKFile type=\"PolyData\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n"
             << "  <PolyData>\n"
             << fmt::format("    <Piece NumberOfPoints=\"{}\" NumberOfVerts=\"{}\">\n", count, count);
         out << "      <PointData>\n";
-        for (const auto& a : arrays) {
+        for (std::size_t k = 0; k < arrays.size(); ++k) {
             out << fmt::format("        <DataArray type=\"Float64\" Name=\"{}\" NumberOfComponents=\"{}\" format=\"appended\" offset=\"{}\"/>\n",
-                               a.name, a.components, offset);
-            offset += block_bytes(a.components);
+                               arrays[k].name, arrays[k].components, offsets[k]);
         }
         out << "      </PointData>\n      <Points>\n";
-        out << fmt::format("        <DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"appended\" offset=\"{}\"/>\n", offset);
-        offset += block_bytes(3);
+        out << fmt::format("        <DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"appended\" offset=\"{}\"/>\n", points);
         out << "      </Points>\n      <Verts>\n";
-        out << fmt::format("        <DataArray type=\"Int64\" Name=\"connectivity\" format=\"appended\" offset=\"{}\"/>\n", offset);
-        offset += 8 + 8 * static_cast<std::uint64_t>(count);
-        out << fmt::format("        <DataArray type=\"Int64\" Name=\"offsets\" format=\"appended\" offset=\"{}\"/>\n", offset);
+        out << fmt::format("        <DataArray type=\"Int64\" Name=\"connectivity\" format=\"appended\" offset=\"{}\"/>\n", connectivity);
+        out << fmt::format("        <DataArray type=\"Int64\" Name=\"offsets\" format=\"appended\" offset=\"{}\"/>\n", vertex_ends);
         out << "      </Verts>\n    </Piece>\n  </PolyData>\n  <AppendedData encoding=\"raw\">\n   _";
-
-        std::vector<char> buffer;
-        const auto put = [&](const void* p, std::size_t n) {
-            const auto* c = static_cast<const char*>(p);
-            buffer.insert(buffer.end(), c, c + n);
-        };
-        const auto flush = [&] {
-            out.write(buffer.data(), static_cast<std::streamsize>(buffer.size()));
-            buffer.clear();
-        };
-        const auto put_block = [&](int components, const std::function<double(std::size_t, int)>& value) {
-            const std::uint64_t bytes = 8 * static_cast<std::uint64_t>(components) * count;
-            put(&bytes, 8);
-            for (std::size_t i = 0; i < count; ++i) {
-                for (int c = 0; c < components; ++c) {
-                    const double v = value(i, c);
-                    put(&v, 8);
-                }
-                if (buffer.size() >= (std::size_t{1} << 20)) flush();  // a bounded buffer: no copy of a whole field
-            }
-            flush();
-        };
-        for (const auto& a : arrays) put_block(a.components, a.value);
-        put_block(3, positions);
-        for (int pass = 0; pass < 2; ++pass) {
-            const std::uint64_t bytes = 8 * static_cast<std::uint64_t>(count);
-            put(&bytes, 8);
-            for (std::size_t i = 0; i < count; ++i) {
-                const std::int64_t v = static_cast<std::int64_t>(pass == 0 ? i : i + 1);
-                put(&v, 8);
-                if (buffer.size() >= (std::size_t{1} << 20)) flush();
-            }
-            flush();
-        }
+        data.write(out);
         out << "\n  </AppendedData>\n</VTKFile>\n";
     });
 }
@@ -125,10 +99,10 @@ void write_pvd(const std::filesystem::path& path, const std::vector<PvdEntry>& e
         out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"1.0\" byte_order=\"LittleEndian\">\n  <Collection>\n";
         for (const auto& e : entries) {
             if (e.name.empty()) {
-                out << fmt::format("    <DataSet timestep=\"{:.9g}\" part=\"0\" file=\"{}\"/>\n", e.time, e.file);
+                out << fmt::format("    <DataSet timestep=\"{:.9g}\" part=\"{}\" file=\"{}\"/>\n", e.time, e.part, e.file);
             } else {
-                out << fmt::format("    <DataSet timestep=\"{:.9g}\" part=\"0\" file=\"{}\" name=\"{}\"/>\n", e.time, e.file,
-                                   e.name);
+                out << fmt::format("    <DataSet timestep=\"{:.9g}\" part=\"{}\" file=\"{}\" name=\"{}\"/>\n", e.time, e.part,
+                                   e.file, e.name);
             }
         }
         out << "  </Collection>\n</VTKFile>\n";

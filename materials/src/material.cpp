@@ -74,6 +74,7 @@ void check_eos(const Checker& c, const EquationOfState& eos) {
 void check_strength(const Checker& c, const Strength& strength) {
     if (const auto* vm = std::get_if<VonMisesStrength>(&strength)) {
         c.non_negative("strength.yield_stress", vm->yield_stress, "Pa");
+        c.non_negative("strength.hardening_modulus", vm->hardening_modulus, "Pa");
     } else if (const auto* jc = std::get_if<JohnsonCookStrength>(&strength)) {
         c.non_negative("strength.a", jc->a, "Pa");
         c.non_negative("strength.b", jc->b, "Pa");

@@ -141,13 +141,20 @@ ReturnResult radial_return(const Strength& strength, const Eigen::Matrix3d& tria
     const double trial_equivalent = von_mises(trial);
 
     if (const auto* vm = std::get_if<VonMisesStrength>(&strength)) {
-        const double y = t_star >= 1.0 ? 0.0 : vm->yield_stress;
+        // Linear hardening Y(eps_p) = Y0 + H eps_p: the consistency condition
+        // sigma_eq* - 3 G x = Y0 + H (eps_p + x) is linear in x = d eps_p, so
+        // x = (sigma_eq* - Y(eps_p)) / (3 G + H) exactly (H = 0: perfect plasticity).
+        const double h = vm->hardening_modulus;
+        const double y = t_star >= 1.0 ? 0.0 : vm->yield_stress + h * plastic_strain;
         elastic.flow_stress = y;
         if (!(trial_equivalent > y)) {
             return elastic;
         }
-        const double increment = shear_modulus > 0.0 ? (trial_equivalent - y) / (3.0 * shear_modulus) : 0.0;
-        return project(trial, trial_equivalent, y, increment);
+        if (!(shear_modulus > 0.0)) return project(trial, trial_equivalent, y, 0.0);
+        // Molten (Y = 0 whatever eps_p): the whole trial deviator returns, without hardening.
+        const double slope = t_star >= 1.0 ? 0.0 : h;
+        const double increment = (trial_equivalent - y) / (3.0 * shear_modulus + slope);
+        return project(trial, trial_equivalent, y + slope * increment, increment);
     }
 
     const auto& jc = std::get<JohnsonCookStrength>(strength);

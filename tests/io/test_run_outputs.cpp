@@ -196,11 +196,13 @@ TEST(Snapshots, OnesOutsideTheScheduleAreMarkedInThePvd) {
     Simulation sim(scene, 1);
     SnapshotSeries series(dir);
     series.write(sim.nodes(), sim.real_count(), 0.0);
-    EXPECT_EQ(series.write_marked(sim.nodes(), sim.real_count(), 2e-8, "failed_step0000003", "failed step 3"),
-              "particles_failed_step0000003.vtp");
+    Snapshot snapshot = take_snapshot(sim);
+    snapshot.time = 2e-8;
+    EXPECT_EQ(series.write_marked(snapshot, "failed_step0000003", "failed step 3"),
+              std::vector<std::string>{"particles_failed_step0000003.vtp"});
     series.write(sim.nodes(), sim.real_count(), 3e-8);
     const std::string pvd = read_all(dir / "particles.pvd");
-    EXPECT_NE(pvd.find(R"(file="particles_failed_step0000003.vtp" name="failed step 3")"), std::string::npos) << pvd;
+    EXPECT_NE(pvd.find(R"(part="0" file="particles_failed_step0000003.vtp" name="failed step 3")"), std::string::npos) << pvd;
     EXPECT_NE(pvd.find(R"(file="particles_00001.vtp"/>)"), std::string::npos) << "the schedule's numbering goes on: " << pvd;
     EXPECT_EQ(series.scheduled(), 2u);
     EXPECT_EQ(series.count(), 3u);

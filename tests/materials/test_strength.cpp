@@ -382,5 +382,44 @@ TEST(Jaumann, PureSpinRotatesTheDeviator) {
     EXPECT_EQ(p.density, m.density);
 }
 
+// Von Mises with linear isotropic hardening, Y = Y0 + H eps_p, in monotonic pure shear (no spin,
+// no volume change, so the loading is radial). The consistency condition is linear in the plastic
+// increment, so the return is exact whatever the step: after an equivalent strain E beyond first
+// yield (E = gamma / sqrt(3) in shear, from zero stress), eps_p = (3 G E - Y0) / (3 G + H) and
+// sigma_eq = Y0 + H eps_p. The plastic work per unit mass, from the mid-step deviator, is the
+// integral of Y over eps_p, (Y0 eps_p + H eps_p^2 / 2) / rho, exact for a linear Y. The Kamoulakos
+// copper bar's constants (docs/validation.md): Y0 400 MPa, H 100 MPa, E 117 GPa, nu 0.35.
+TEST(RadialReturn, LinearHardeningMatchesTheClosedFormAtAnyStepSize) {
+    Material m;
+    m.name = "linear-hardening copper";
+    m.density = 8930.0;
+    m.shear_modulus = 117e9 / (2.0 * 1.35);
+    m.eos = LinearEos{117e9 / (3.0 * (1.0 - 0.7)), false};
+    m.strength = VonMisesStrength{400e6, 100e6};
+    const double g = m.shear_modulus, y0 = 400e6, h = 100e6;
+    for (const int steps : {7, 100, 2500}) {
+        Driver p(m);
+        const double gamma = 0.3;  // total engineering shear strain, far beyond yield (~0.6e-2)
+        const double rate = 1e4, dt = gamma / rate / steps;
+        double plastic_work = 0.0;
+        for (int i = 0; i < steps; ++i) plastic_work += p.step(pure_shear(rate), dt).plastic_work;
+        const double e_total = gamma / std::sqrt(3.0);
+        const double eps_p = (3.0 * g * e_total - y0) / (3.0 * g + h);
+        EXPECT_NEAR(p.state.plastic_strain, eps_p, 1e-12 * eps_p) << steps;
+        EXPECT_NEAR(von_mises(p.state.deviatoric_stress), y0 + h * eps_p, 1e-12 * y0) << steps;
+        const double work = (y0 * eps_p + 0.5 * h * eps_p * eps_p) / m.density;
+        // The first yielding step splits its increment at the yield point only approximately (the
+        // mid-step deviator averages an elastic start with a plastic end): that step's error is at
+        // most its own share of the work, Y0 d eps_p / rho with d eps_p <= eps_p / (steps - 1).
+        const double first_step = y0 * eps_p / (steps - 1) / m.density;
+        EXPECT_NEAR(plastic_work, work, first_step + 1e-12 * work) << steps;
+    }
+    // H = 0 is the perfectly plastic return.
+    m.strength = VonMisesStrength{400e6, 0.0};
+    Driver p(m);
+    for (int i = 0; i < 50; ++i) p.step(pure_shear(1e4), 1e-6);
+    EXPECT_NEAR(von_mises(p.state.deviatoric_stress), y0, 1e-12 * y0);
+}
+
 }  // namespace
 }  // namespace gpa::materials

@@ -20,6 +20,11 @@ std::size_t add_body_nodes(NodeStore& nodes, const Scene& scene, std::size_t bod
 // The lattice a body is filled with (exposed for tests and reports).
 LatticeBlock body_lattice(const Scene& scene, std::size_t body);
 
+// The initial volumetric strain that puts the equation of state of `material` at pressure p
+// (e = 0): how a body's initial mean stress becomes an initial compression (particles and
+// elements alike). Throws InputError naming the body when the EOS does not reach p.
+double initial_volumetric_strain(const materials::Material& material, double pressure, const std::string& body);
+
 // Index of the named material in scene.materials; throws InputError naming the body otherwise.
 std::size_t material_index(const Scene& scene, const std::string& name, const std::string& body);
 

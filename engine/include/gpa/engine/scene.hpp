@@ -53,8 +53,16 @@ enum class ShapeKind {
 std::string_view name_of(ShapeKind s);
 bool is_round(ShapeKind s);
 
+// How a body is discretised: a lattice of GPA particles, or explicit Lagrangian finite elements
+// (quadrilaterals of four crossed triangles with mean dilatation, 2D only; docs/elements.md),
+// meshed from the same shape at the same spacing.
+enum class Discretisation { Particles, Elements };
+
+std::string_view name_of(Discretisation d);
+
 struct BodySpec {
     std::string name;
+    Discretisation discretisation = Discretisation::Particles;
     ShapeKind shape = ShapeKind::Cylinder;
     // Cylinder/plate: origin is the centre of the base (lower z end); Rectangle/box: lower
     // corner; Sphere: centre. Axisymmetric cylinders, plates and spheres must have origin x = 0.
@@ -69,8 +77,8 @@ struct BodySpec {
     // Initial Cauchy stress in NodeStore order (2D: xx, zz, xz, out-of-plane; 3D: xx, yy, zz, yz,
     // xz, xy). Its deviator becomes s; its mean stress becomes an initial compression through the EOS.
     std::array<double, 6> initial_stress{0, 0, 0, 0, 0, 0};
-    std::optional<ConnectivityMode> connectivity;  // overrides SolverOptions::connectivity
-    int lattice_neighbours = 0;                    // fixed lists: 4/8 (2D), 6/18/26 (3D); 0 = 8 or 26
+    std::optional<ConnectivityMode> connectivity;  // overrides SolverOptions::connectivity (particles only)
+    int lattice_neighbours = 0;                    // fixed lists: 4/8 (2D), 6/18/26 (3D); 0 = 8 or 26 (particles only)
 };
 
 enum class PlaneKind {

@@ -14,6 +14,11 @@
 //   lattice cells checked; fixed -> variable above the    [switching]
 //     plastic-strain threshold or where a cell collapsed
 //
+// Element bodies (elements.hpp) take part in the same step with phases of their own, between the
+// particle phases of the same name: element move after move, element stress after stress,
+// element forces after forces, element integrate after integrate; the time step, the totals and
+// the energy booking cover both.
+//
 // After step() the positions, stresses and energies are those of t^{n+1}; velocities are the
 // half step ahead (v^{n+3/2}), and the kinetic energy reported for t^{n+1} is the mean of the two
 // half steps around it.
@@ -57,9 +62,13 @@ struct Totals {
     std::array<double, 3> momentum{0, 0, 0};  // sum M v^{n+3/2}, kg m/s: half a step ahead, like the impulse
                                               // (the axial component is the meaningful one in axisymmetric)
     std::vector<PlaneReport> planes;          // rigid planes, scene order
-    double length = 0.0;              // max over nodes of (distance from the first rigid plane + d/2), m
-    double footprint_diameter = 0.0;  // width of the nodes within d of the first rigid plane, m
+    // Final length and footprint against the first rigid plane, by the rules of measure.hpp
+    // (docs/measurement.md): particles reach d/2 beyond their centres, element nodes lie on the
+    // boundary.
+    double length = 0.0;              // highest point above the plane, m
+    double footprint_diameter = 0.0;  // width of the body on the plane, m
     std::size_t real_nodes = 0, ghost_nodes = 0, variable_nodes = 0, failed_nodes = 0, pairs = 0;
+    std::size_t element_nodes = 0, elements = 0;  // nodes and quadrilaterals of element bodies
     std::size_t neighbour_searches = 0;  // full searches so far (the others steps reuse candidate lists)
     // Fixed nodes of automatic bodies that the last step switched because a lattice cell had
     // collapsed or inverted (before their plastic strain reached the threshold), and the first of them.
@@ -77,6 +86,8 @@ struct CheckpointInfo {
     double time = 0.0;
     std::string user_data;
 };
+
+class ElementPart;
 
 class Simulation {
 public:
@@ -110,8 +121,13 @@ public:
     std::vector<PhaseTime> phase_times() const;
     // The names of the phases in this scene's graph, in order.
     std::vector<std::string> phases() const;
-    // Real node-steps processed so far (sum over steps of the real node count).
+    // Node-steps processed so far (sum over steps of the real particle nodes and the nodes of
+    // element bodies).
     double node_steps() const;
+    // Element-steps (quadrilaterals times steps) processed so far.
+    double element_steps() const;
+    // The element bodies (nullptr when the scene has none).
+    const ElementPart* elements() const;
     // The neighbour lists of the last step: rows [0, real_count()) of the real nodes, then the
     // rows of the ghosts (indices >= real_count() are ghosts).
     const CompressedRows& neighbour_lists() const;
@@ -125,6 +141,9 @@ public:
     // versioned and carries build_id(), `scene_fingerprint` (what identifies the scene to the
     // caller, e.g. a hash of its file) and `user_data` (anything the caller wants back).
     void save_checkpoint(std::ostream& out, std::string_view scene_fingerprint, std::string_view user_data = {}) const;
+    // False for scenes with element bodies: their state is not in the checkpoint format yet, and
+    // save_checkpoint refuses them (InputError) rather than write one that would not resume exactly.
+    bool can_checkpoint() const;
     // Restores a checkpoint of `size` bytes (`source` names it in messages) into a Simulation
     // built from the same scene; returns its user_data. Throws CheckpointError, before changing
     // anything, when the format, the build or the scene fingerprint differ; for a damaged file

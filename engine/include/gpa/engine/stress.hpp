@@ -3,8 +3,12 @@
 // volume and density, nodal artificial viscosity (Eq. 36), and the material point update
 // (Jaumann rate, strength, equation of state, energy, temperature, damage).
 
+#include <array>
 #include <cstddef>
+#include <cstdint>
+#include <mutex>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "gpa/engine/node_store.hpp"
@@ -36,5 +40,81 @@ Eigen::Matrix3d full_velocity_gradient(const NodeStore& nodes, std::size_t i);
 // nodes of each material (before the first step).
 void initialise_material_state(NodeStore& nodes, std::size_t real_count,
                                const std::vector<materials::Material>& materials);
+
+// --- the material point update shared by particle nodes and element triangles -------------
+//
+// Particle nodes (NodeStore) and the triangles of element bodies (elements.hpp) keep the same
+// material state as structure-of-arrays fields; both present them as MaterialPointFields, so that
+// both go through one update (advance_material_point, which calls materials::update_point) and
+// one start state (initial_material_point). What differs is only how each finds its velocity
+// gradient, densities and viscous pressure (spec section 3 for nodes, docs/elements.md for
+// elements).
+
+// Pointers to the state arrays of a set of material points. Stress components in the 2D or 3D
+// order of geometry.hpp (2D: xx, zz, xz, out-of-plane; 3D: xx, yy, zz, yz, xz, xy).
+struct MaterialPointFields {
+    std::array<double*, 6> deviatoric_stress{};
+    double* pressure = nullptr;
+    double* internal_energy = nullptr;  // specific, J/kg
+    double* plastic_strain = nullptr;
+    double* temperature = nullptr;
+    double* damage = nullptr;
+    std::uint8_t* failed = nullptr;
+    double* sound_speed = nullptr;
+    double* plastic_work = nullptr;  // accumulated specific plastic work, J/kg
+    double* viscous_work = nullptr;  // accumulated specific viscous work, J/kg
+};
+
+// The fields of any store that names them so (NodeStore, ElementPoints), with `components`
+// stress components (stress_components(dim)).
+template <class Store>
+MaterialPointFields material_point_fields(Store& store, int components) {
+    MaterialPointFields f;
+    for (int c = 0; c < components; ++c) f.deviatoric_stress[static_cast<std::size_t>(c)] = store.deviatoric_stress[static_cast<std::size_t>(c)].data();
+    f.pressure = store.pressure.data();
+    f.internal_energy = store.internal_energy.data();
+    f.plastic_strain = store.plastic_strain.data();
+    f.temperature = store.temperature.data();
+    f.damage = store.damage.data();
+    f.failed = store.failed.data();
+    f.sound_speed = store.sound_speed.data();
+    f.plastic_work = store.plastic_work.data();
+    f.viscous_work = store.viscous_work.data();
+    return f;
+}
+
+// Advances point i over the increment with materials::update_point and writes the new state back
+// (deviator, pressure, energy, plastic strain, temperature, damage, failure, sound speed, and the
+// plastic and viscous work added to their totals). D is the dimension of the stress order. Throws
+// what update_point throws, with the state untouched.
+template <int D>
+materials::PointResult advance_material_point(const MaterialPointFields& f, std::size_t i,
+                                              const materials::Material& material,
+                                              const materials::PointIncrement& increment);
+
+// The state of an unloaded point at `density`: pressure from the equation of state at e = 0 and
+// the longitudinal sound speed sqrt((K + 4 G / 3) / rho) (K floored at 0).
+struct InitialPointState {
+    double pressure = 0.0;
+    double sound_speed = 0.0;
+};
+InitialPointState initial_material_point(const materials::Material& material, double density,
+                                         double specific_internal_energy = 0.0);
+
+// The first failure of a parallel loop over points: the smallest index and its message, so that
+// the error reported does not depend on the thread count.
+class FirstPointFailure {
+public:
+    void record(std::size_t index, std::string message);
+    bool any() const { return index_ != none; }
+    std::size_t index() const { return index_; }
+    const std::string& message() const { return message_; }
+    static constexpr std::size_t none = static_cast<std::size_t>(-1);
+
+private:
+    std::mutex mutex_;
+    std::size_t index_ = none;
+    std::string message_;
+};
 
 }  // namespace gpa

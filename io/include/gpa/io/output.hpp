@@ -68,26 +68,38 @@ private:
     std::size_t planes_;
 };
 
-// particles_NNNNN.vtp and particles.pvd in a folder; the index is rewritten after every
-// snapshot so that it always lists the snapshots on disk.
+// What one snapshot shows, copied out of a run so that it can be written while the run goes on:
+// the real particle nodes and the element bodies.
+struct Snapshot {
+    double time = 0.0;
+    NodeStore particles{GeometryKind::Axisymmetric};
+    std::optional<ElementMesh> elements;
+};
+Snapshot take_snapshot(const Simulation& sim);
+
+// particles_NNNNN.vtp (particle bodies), elements_NNNNN.vtu (element bodies) and particles.pvd,
+// the time series of both, in a folder; the index is rewritten after every snapshot so that it
+// always lists the snapshots on disk.
 class SnapshotSeries {
 public:
     explicit SnapshotSeries(std::filesystem::path folder, std::string stem = "particles");
-    // Writes nodes [0, count) at time t as the next scheduled snapshot (particles_NNNNN.vtp);
-    // returns the file name.
+    // Writes the snapshot's particles (if any) and element bodies (if any) as the parts of the next
+    // scheduled time step (particles_NNNNN.vtp, elements_NNNNN.vtu); returns the file names.
+    std::vector<std::string> write(const Snapshot& snapshot);
+    // Particle nodes [0, count) alone at time t as the next scheduled step; returns the file name.
     std::string write(const NodeStore& nodes, std::size_t count, double time);
-    // Writes a snapshot outside the schedule, named <stem>_<label>.vtp and marked `mark` in the
-    // .pvd (e.g. label "failed_step00027", mark "failed step 27").
-    std::string write_marked(const NodeStore& nodes, std::size_t count, double time, const std::string& label,
-                             const std::string& mark);
-    std::size_t count() const { return entries_.size(); }
-    std::size_t scheduled() const { return scheduled_; }
+    // A snapshot outside the schedule, <stem>_<label>.vtp and elements_<label>.vtu, marked `mark`
+    // in the .pvd (e.g. label "failed_step00027", mark "failed step 27").
+    std::vector<std::string> write_marked(const Snapshot& snapshot, const std::string& label, const std::string& mark);
+    std::size_t count() const { return entries_.size(); }  // files listed in the .pvd
+    std::size_t scheduled() const { return scheduled_; }   // scheduled time steps written
     const std::vector<PvdEntry>& entries() const { return entries_; }
-    // A resumed run carries on a series: its entries so far, `scheduled` of them on the schedule
-    // (the .pvd is rewritten to list exactly these).
+    // A resumed run carries on a series: its entries so far, `scheduled` time steps of them on the
+    // schedule (the .pvd is rewritten to list exactly these).
     void restore(std::vector<PvdEntry> entries, std::size_t scheduled);
 
 private:
+    std::vector<std::string> write_parts(const Snapshot& snapshot, const std::string& suffix, const std::string& mark);
     std::filesystem::path folder_;
     std::string stem_;
     std::vector<PvdEntry> entries_;
@@ -111,10 +123,12 @@ struct RunSummary {
 void write_summary(const std::filesystem::path& file, const Simulation& sim, const RunSummary& run);
 
 // profile.csv: the outline of the bodies seen from the first rigid plane, for comparing a
-// Taylor specimen with its measured outline: for bins of height above the plane (one mean node
-// diameter wide), the largest radial extent plus d/2 (axisymmetric: the radius x; otherwise the
-// distance from the vertical through the nodes' centroid). Heights and radii in m. Does nothing
-// without a rigid plane.
+// Taylor specimen with its measured outline (axisymmetric: radius x; otherwise the distance from
+// the vertical through the nodes' centroid), by the rules of measure.hpp. Particle bodies: for
+// bins of height above the plane (one mean node diameter wide), the largest radial extent plus
+// d/2. Element bodies: the outline of the mesh's boundary, the largest radius of the boundary
+// edges at each boundary node's height. Both end with (top, 0). Heights and radii in m. Does
+// nothing without a rigid plane.
 void write_profile(const std::filesystem::path& file, const Simulation& sim);
 
 // The scene's reference answers compared with the run: key -> {reference, computed, relative error}.

@@ -1,14 +1,18 @@
 #pragma once
-// ParaView-readable particle snapshots: VTK XML PolyData (.vtp) with one vertex per node and
-// the node fields as point data, and a .pvd time-series index over snapshots.
+// ParaView-readable snapshots: particles as VTK XML PolyData (.vtp) with one vertex per node and
+// the node fields as point data, element bodies as an UnstructuredGrid (.vtu) of triangles, and
+// a .pvd time-series index over snapshots (a snapshot with both kinds lists both files as parts
+// of one time step).
 // 2D nodes are written in the X-Y plane as (x, z, 0), so that ParaView shows the axial
 // direction upwards.
 
+#include <array>
 #include <cstddef>
 #include <filesystem>
 #include <string>
 #include <vector>
 
+#include "gpa/engine/elements.hpp"
 #include "gpa/engine/node_store.hpp"
 
 namespace gpa::io {
@@ -22,10 +26,19 @@ struct PvdEntry {
     double time;
     std::string file;  // relative to the .pvd
     std::string name = {};  // a mark such as "failed step 27" (the DataSet's name attribute); empty: none
+    int part = 0;           // files of one time step are parts 0, 1, ...
 };
 void write_pvd(const std::filesystem::path& path, const std::vector<PvdEntry>& entries);
 
 // Equivalent (von Mises) stress of node i from its deviatoric stress, sqrt(3/2 s:s), Pa.
 double von_mises_stress(const NodeStore& nodes, std::size_t i);
+// The same from deviator components in the order of geometry.hpp (2D: xx, zz, xz, out-of-plane).
+double von_mises_stress(const std::array<double, 6>& s, int dim);
+
+// Element bodies as a VTK XML UnstructuredGrid (.vtu): the element nodes as points (velocity,
+// force, mass, body), the triangles as cells (pressure, von Mises stress, plastic strain,
+// temperature, damage, density, specific internal energy, viscous pressure, material, and the
+// quadrilateral each belongs to). Written atomically, like write_vtp.
+void write_vtu(const std::filesystem::path& path, const ElementMesh& mesh);
 
 }  // namespace gpa::io

@@ -56,8 +56,12 @@ EosResult evaluate_eos(const EquationOfState& eos, double reference_density, dou
 
 struct ElasticStrength {};
 
+// Von Mises with linear isotropic hardening: Y = yield_stress + hardening_modulus eps_p
+// (hardening_modulus 0: perfectly plastic). hardening_modulus is the plastic modulus H = dY/d eps_p;
+// a tangent modulus E_t of the uniaxial stress-strain curve converts as H = E E_t / (E - E_t).
 struct VonMisesStrength {
-    double yield_stress = 0.0;  // Pa
+    double yield_stress = 0.0;       // Y0, Pa
+    double hardening_modulus = 0.0;  // H, Pa
 };
 
 // Y = (A + B eps_p^n)(1 + C ln(max(epsdot / epsdot0, 1)))(1 - T*^m), T* clamped to [0, 1].

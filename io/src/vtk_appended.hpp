@@ -1,0 +1,76 @@
+#pragma once
+// The appended raw-data section of VTK XML files (.vtp, .vtu): arrays declared one after another,
+// each written as a UInt64 byte count and its values, through a bounded buffer (no copy of a
+// whole field). Private to io/.
+
+#include <cstdint>
+#include <cstring>
+#include <fstream>
+#include <functional>
+#include <vector>
+
+namespace gpa::io::detail {
+
+class AppendedBlocks {
+public:
+    // A Float64 array of `components` values for each of `count` entries; returns its offset in
+    // the appended section (the `offset` attribute of its DataArray).
+    std::uint64_t add_float(std::size_t count, int components, std::function<double(std::size_t, int)> value) {
+        return add(count, components, 8, [value = std::move(value)](std::size_t i, int c, char* out) {
+            const double v = value(i, c);
+            std::memcpy(out, &v, 8);
+        });
+    }
+    // An Int64 array (connectivity, offsets).
+    std::uint64_t add_int64(std::size_t count, std::function<std::int64_t(std::size_t)> value) {
+        return add(count, 1, 8, [value = std::move(value)](std::size_t i, int, char* out) {
+            const std::int64_t v = value(i);
+            std::memcpy(out, &v, 8);
+        });
+    }
+    // A UInt8 array (cell types).
+    std::uint64_t add_uint8(std::size_t count, std::function<std::uint8_t(std::size_t)> value) {
+        return add(count, 1, 1, [value = std::move(value)](std::size_t i, int, char* out) { *out = static_cast<char>(value(i)); });
+    }
+
+    // Writes every block, in the order declared.
+    void write(std::ofstream& out) const {
+        std::vector<char> buffer;
+        const auto flush = [&] {
+            out.write(buffer.data(), static_cast<std::streamsize>(buffer.size()));
+            buffer.clear();
+        };
+        for (const Block& b : blocks_) {
+            const std::uint64_t bytes = static_cast<std::uint64_t>(b.count) * b.components * b.width;
+            const char* p = reinterpret_cast<const char*>(&bytes);
+            buffer.insert(buffer.end(), p, p + 8);
+            char value[8];
+            for (std::size_t i = 0; i < b.count; ++i) {
+                for (int c = 0; c < b.components; ++c) {
+                    b.put(i, c, value);
+                    buffer.insert(buffer.end(), value, value + b.width);
+                }
+                if (buffer.size() >= (std::size_t{1} << 20)) flush();
+            }
+            flush();
+        }
+    }
+
+private:
+    struct Block {
+        std::size_t count;
+        int components;
+        int width;
+        std::function<void(std::size_t, int, char*)> put;
+    };
+    std::uint64_t add(std::size_t count, int components, int width, std::function<void(std::size_t, int, char*)> put) {
+        const std::uint64_t at = offset_;
+        offset_ += 8 + static_cast<std::uint64_t>(count) * components * width;
+        blocks_.push_back({count, components, width, std::move(put)});
+        return at;
+    }
+    std::vector<Block> blocks_;
+    std::uint64_t offset_ = 0;
+};
+
+}  // namespace gpa::io::detail
