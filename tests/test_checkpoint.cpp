@@ -18,14 +18,6 @@
 namespace gpa {
 namespace {
 
-// Every field of every node (ghosts included) and the fixed lists, as bytes.
-std::string node_bytes(const Simulation& sim) {
-    std::ostringstream out;
-    StateWriter w(out);
-    sim.nodes().write_state(w);
-    return out.str();
-}
-
 // The totals a history row and a summary print, as bytes.
 std::string totals_bytes(const Totals& t) {
     std::string out;
@@ -140,7 +132,8 @@ TEST(Checkpoint, AResumedRunIsBitIdenticalToOneNeverStoppedOnOneAndTwoThreads) {
             for (int k = c.stop_at; k < c.steps; ++k) never_stopped.step();
             for (int k = c.stop_at; k < c.steps; ++k) resumed.step();
             ASSERT_EQ(never_stopped.steps(), resumed.steps());
-            EXPECT_TRUE(node_bytes(never_stopped) == node_bytes(resumed)) << "node data differ after " << c.steps << " steps";
+            EXPECT_TRUE(testing::node_bytes(never_stopped) == testing::node_bytes(resumed))
+                << "node data differ after " << c.steps << " steps";
             EXPECT_TRUE(totals_bytes(never_stopped.totals()) == totals_bytes(resumed.totals()));
             EXPECT_TRUE(never_stopped.neighbour_lists() == resumed.neighbour_lists());
             EXPECT_EQ(never_stopped.node_steps(), resumed.node_steps());
@@ -157,7 +150,7 @@ TEST(Checkpoint, WritingOneChangesNothing) {
         saving.step();
         if (k % 7 == 0) (void)checkpoint_of(saving);
     }
-    EXPECT_TRUE(node_bytes(plain) == node_bytes(saving));
+    EXPECT_TRUE(testing::node_bytes(plain) == testing::node_bytes(saving));
 }
 
 template <class F>
@@ -185,7 +178,7 @@ TEST(Checkpoint, ThoseOfAnotherSceneBuildOrFormatAreRefusedBeforeAnythingChanges
     EXPECT_EQ(info_of(saved).format, Simulation::checkpoint_format);
 
     Simulation b(scene, 1);
-    const std::string before = node_bytes(b);
+    const std::string before = testing::node_bytes(b);
     auto m = refusal([&] { restore(b, saved, "scene-b"); });
     EXPECT_NE(m.find("another scene"), std::string::npos) << m;
     // Another build: the build id is the first text of the header.
@@ -203,7 +196,7 @@ TEST(Checkpoint, ThoseOfAnotherSceneBuildOrFormatAreRefusedBeforeAnythingChanges
     m = refusal([&] { restore(b, std::string("not a checkpoint at all")); });
     EXPECT_NE(m.find("not a gpa checkpoint"), std::string::npos) << m;
     // None of these touched b: it still steps like a fresh run.
-    EXPECT_TRUE(node_bytes(b) == before);
+    EXPECT_TRUE(testing::node_bytes(b) == before);
     EXPECT_NO_THROW(b.step());
 }
 

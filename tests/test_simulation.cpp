@@ -100,25 +100,6 @@ TEST(Momentum, WithoutPlanesItIsConservedToRoundOff) {
     EXPECT_NEAR(axial_momentum(sim), 0.0, 1e-13 * total_mass(sim) * speed);
 }
 
-std::vector<std::uint8_t> bytes_of(const NodeStore& n, std::size_t count) {
-    std::vector<std::uint8_t> out;
-    const auto add = [&](const std::vector<double>& v) {
-        const auto* p = reinterpret_cast<const std::uint8_t*>(v.data());
-        out.insert(out.end(), p, p + count * sizeof(double));
-    };
-    for (int c = 0; c < n.dim(); ++c) {
-        add(n.position[c]);
-        add(n.velocity[c]);
-        add(n.force[c]);
-    }
-    for (int c = 0; c < 4; ++c) add(n.deviatoric_stress[c]);
-    add(n.pressure);
-    add(n.internal_energy);
-    add(n.plastic_strain);
-    add(n.temperature);
-    add(n.volume);
-    return out;
-}
 
 TEST(Threads, AFullShortRunIsBitIdenticalOnOneAndTwoThreads) {
     for (bool smoothing : {false, true}) {
@@ -131,7 +112,7 @@ TEST(Threads, AFullShortRunIsBitIdenticalOnOneAndTwoThreads) {
             two.step();
         }
         ASSERT_EQ(one.real_count(), two.real_count());
-        EXPECT_TRUE(bytes_of(one.nodes(), one.real_count()) == bytes_of(two.nodes(), two.real_count()))
+        EXPECT_TRUE(testing::node_bytes(one) == testing::node_bytes(two))
             << (smoothing ? "with smoothing" : "without smoothing");
         EXPECT_EQ(std::memcmp(&one.totals().energy_error, &two.totals().energy_error, sizeof(double)), 0);
     }

@@ -175,24 +175,6 @@ TEST(LatticeCells, CollapsedCellsOfAnAutomaticBodySwitchAtOnce) {
     EXPECT_LT(std::abs(automatic.totals().energy_error), 0.01);
 }
 
-std::vector<std::uint8_t> node_bytes(const Simulation& sim) {
-    const NodeStore& n = sim.nodes();
-    std::vector<std::uint8_t> out;
-    const auto add = [&](const auto& v) {
-        const auto* p = reinterpret_cast<const std::uint8_t*>(v.data());
-        out.insert(out.end(), p, p + sim.real_count() * sizeof(v[0]));
-    };
-    for (int c = 0; c < n.dim(); ++c) {
-        add(n.position[c]);
-        add(n.velocity[c]);
-    }
-    for (int c = 0; c < 4; ++c) add(n.deviatoric_stress[c]);
-    add(n.pressure);
-    add(n.internal_energy);
-    add(n.plastic_strain);
-    add(n.connectivity);
-    return out;
-}
 
 // A short automatic run in which nodes switch, with the hourglass control on: the same bits on 1
 // and 2 threads.
@@ -208,7 +190,7 @@ TEST(Switching, AnAutomaticRunIsBitIdenticalOnOneAndTwoThreads) {
     EXPECT_GT(one.totals().variable_nodes, 0u);
     EXPECT_LT(one.totals().variable_nodes, one.real_count());
     EXPECT_GT(one.totals().hourglass_work, 0.0);
-    EXPECT_TRUE(node_bytes(one) == node_bytes(two));
+    EXPECT_TRUE(testing::node_bytes(one) == testing::node_bytes(two));
     EXPECT_EQ(std::memcmp(&one.totals().energy_error, &two.totals().energy_error, sizeof(double)), 0);
 }
 

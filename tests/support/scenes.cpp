@@ -1,5 +1,9 @@
 #include "support/scenes.hpp"
 
+#include <sstream>
+
+#include "gpa/engine/state_io.hpp"
+
 namespace gpa::testing {
 
 materials::Material elastic_material(const std::string& name, double density, double young, double poisson) {
@@ -41,6 +45,13 @@ Scene elastic_bar_on_plane(double radius, double length, int radial_cells, doubl
     s.solver.connectivity = ConnectivityMode::Variable;
     s.stop.end_time = 3.0 * length / 5000.0;
     return s;
+}
+
+std::string node_bytes(const Simulation& sim) {
+    std::ostringstream out;
+    StateWriter w(out);
+    sim.nodes().write_state(w);
+    return out.str();
 }
 
 Scene armco_cylinder(int radial_cells, double end_time) {

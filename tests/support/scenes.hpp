@@ -1,7 +1,10 @@
 #pragma once
 // Scenes built in code for the engine's run tests.
 
+#include <string>
+
 #include "gpa/engine/scene.hpp"
+#include "gpa/engine/simulation.hpp"
 
 namespace gpa::testing {
 
@@ -11,6 +14,10 @@ materials::Material elastic_material(const std::string& name, double density, do
 // An axisymmetric bar of radius R and length L standing on a rigid plane at z = 0 (lift-off
 // allowed) and moving towards it at `speed`; spacing = R / radial_cells.
 Scene elastic_bar_on_plane(double radius, double length, int radial_cells, double speed);
+
+// Every field of every node of a run (ghosts included) and the fixed lists, as bytes (the
+// checkpoint encoding of NodeStore): for comparing runs bit for bit.
+std::string node_bytes(const Simulation& sim);
 
 // The paper's Armco-iron cylinder (L0 15.2 mm, D0 10.2 mm, 305 m/s) at `radial_cells` across
 // the radius, nodal viscosity, no lift-off, with the given end time.
