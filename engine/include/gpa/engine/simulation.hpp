@@ -32,6 +32,7 @@
 #include <string_view>
 #include <vector>
 
+#include "gpa/engine/body_report.hpp"
 #include "gpa/engine/compressed_rows.hpp"
 #include "gpa/engine/limits.hpp"
 #include "gpa/engine/node_store.hpp"
@@ -62,6 +63,9 @@ struct Totals {
     std::array<double, 3> momentum{0, 0, 0};  // sum M v^{n+3/2}, kg m/s: half a step ahead, like the impulse
                                               // (the axial component is the meaningful one in axisymmetric)
     std::vector<PlaneReport> planes;          // rigid planes, scene order
+    // Every body of the scene, scene order (element bodies carry zeros): energies and momentum every
+    // step; pieces, residual velocity and crater (body_report.hpp) as of the last measure_bodies().
+    std::vector<BodyTotals> bodies;
     // Final length and footprint against the first rigid plane, by the rules of measure.hpp
     // (docs/measurement.md): particles reach d/2 beyond their centres, element nodes lie on the
     // boundary.
@@ -113,6 +117,10 @@ public:
     const NodeStore& nodes() const;
     std::size_t real_count() const;
     const Totals& totals() const;
+    // Measures the bodies' pieces, residual velocities and craters (body_report.hpp) from the
+    // current state into totals().bodies; the run program calls it before every history row and the
+    // summary (it is a union-find over the lists, too much to do every step).
+    void measure_bodies();
     double time() const;
     std::size_t steps() const;
     // The time step the next step() advances by (dt^{n+1/2}; totals().time_step is the last one taken).
@@ -153,7 +161,7 @@ public:
     // Reads the header of a checkpoint (no Simulation needed). Throws CheckpointError.
     static CheckpointInfo checkpoint_info(std::istream& in, std::uint64_t size, const std::string& source);
     // The format version save_checkpoint writes.
-    static constexpr std::uint32_t checkpoint_format = 1;
+    static constexpr std::uint32_t checkpoint_format = 2;
 
 private:
     struct Impl;
