@@ -436,7 +436,9 @@ TEST(Render, AxisymmetricRunsAreMirroredAboutTheAxisUnlessAskedNotTo) {
     EXPECT_FALSE(q.mirrored);
     // Without the image, x = -1 mm is outside the drawing or in the background.
     const auto [x, y] = q.frame.pixel(-1e-3, 1e-3);
-    if (x >= 0 && x < q.image.width) EXPECT_EQ(q.image.at(static_cast<int>(x), static_cast<int>(y)), background_colour);
+    if (x >= 0 && x < q.image.width) {
+        EXPECT_EQ(q.image.at(static_cast<int>(x), static_cast<int>(y)), background_colour);
+    }
     // Mirroring a plane-strain run is asked for.
     o.mirror = true;
     EXPECT_TRUE(render_snapshot(s, GeometryKind::PlaneStrain, o).mirrored);
@@ -549,6 +551,34 @@ TEST(Render, ElementCellsAreFilledWithTheirCellValues) {
         EXPECT_EQ(pixel_at(p, u, v), colour_map((value - lo) / (hi - lo))) << "triangle " << t;
         EXPECT_EQ(pixel_at(p, -u, v), colour_map((value - lo) / (hi - lo))) << "mirrored triangle " << t;
     }
+    // A point field is interpolated across each triangle: a field linear in z comes out as that
+    // line at every pixel's centre (to one colour level: the interpolation's round-off may cross
+    // a level of the 8-bit map).
+    Snapshot moving = snapshot;
+    ElementNodes& nodes = moving.elements->nodes;
+    const auto linear = [](double z) { return 2.0e3 * z - 1.0; };
+    for (std::size_t i = 0; i < nodes.size(); ++i) nodes.velocity[1][i] = linear(nodes.position[1][i]);
+    const fs::path dir2 = fresh_dir("element_points");
+    SnapshotSeries(dir2).write(moving);
+    o.field = "velocity:z";
+    const Picture lines = render_snapshot(load_snapshot(read_pvd(dir2 / "particles.pvd"), 0), GeometryKind::Axisymmetric, o);
+    std::size_t checked = 0;
+    for (double z = 0.1e-3; z < 2.95e-3; z += 0.37e-3) {
+        for (double x : {-1.7e-3, -0.2e-3, 0.6e-3, 1.3e-3}) {
+            const auto [px, py] = lines.frame.pixel(x, z);
+            const int ix = static_cast<int>(std::floor(px)), iy = static_cast<int>(std::floor(py));
+            // the z of this pixel's centre
+            const double centre_z = lines.frame.v_top - (iy + 0.5 - lines.frame.top) / lines.frame.scale;
+            const Rgb want = colour_map((linear(centre_z) - lines.range_min) / (lines.range_max - lines.range_min));
+            const Rgb got = lines.image.at(ix, iy);
+            EXPECT_LE(std::abs(int(got.r) - int(want.r)), 1) << x << " " << z;
+            EXPECT_LE(std::abs(int(got.g) - int(want.g)), 1) << x << " " << z;
+            EXPECT_LE(std::abs(int(got.b) - int(want.b)), 1) << x << " " << z;
+            ++checked;
+        }
+    }
+    EXPECT_EQ(checked, 32u);
+
     // A field the elements do not have: a particle field.
     o.field = "connectivity";
     EXPECT_TRUE(contains(error_of([&] { render_snapshot(s, GeometryKind::Axisymmetric, o); }), "no field 'connectivity'"));
