@@ -9,7 +9,6 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
-#include <numeric>
 
 #include <fmt/format.h>
 #include <png.h>
@@ -611,8 +610,9 @@ Picture render_snapshot(const LoadedSnapshot& snapshot, GeometryKind geometry, c
         lo = std::min(lo, v);
         hi = std::max(hi, v);
     };
+    // Over the nodes and cells once: mirrored images are the second half of each list (3D runs,
+    // which are sorted, are never mirrored).
     const std::size_t own_discs = picture.discs, own_triangles = picture.triangles;
-    // (counted over the first copy only; painter's sorting happens in 3D, where nothing is mirrored)
     for (std::size_t i = 0; i < own_discs; ++i) count_value(discs[i].value, discs[i].has_value);
     for (std::size_t i = 0; i < own_triangles; ++i) {
         for (double v : triangles[i].value) count_value(v, triangles[i].has_value);
@@ -656,10 +656,9 @@ Picture render_snapshot(const LoadedSnapshot& snapshot, GeometryKind geometry, c
         for (double f : tick_fractions) tick_labels.push_back(number_text((lo + f * (hi - lo)) / divisor));
     }
     const int width = options.width;
-    const int provisional_scale = std::clamp(static_cast<int>(std::lround(
-                                                 std::min(width, options.height > 0 ? options.height : width) / 450.0)),
-                                             1, 4);
-    const int s = provisional_scale;
+    // The text's scale: one font pixel per 450 picture pixels of the shorter side given, 1 to 4.
+    const int s = std::clamp(static_cast<int>(std::lround(std::min(width, options.height > 0 ? options.height : width) / 450.0)),
+                             1, 4);
     const int margin = 8 * s, text_h = detail::text_height(s), line = detail::line_height * s;
     int label_w = 0;
     for (const auto& l : tick_labels) label_w = std::max(label_w, detail::text_width(l, s));

@@ -445,7 +445,11 @@ VtkFile::VtkFile(fs::path path) : path_(std::move(path)) {
                 ref.role = ref.info.name;
                 ref.info.location = DataLocation::Cell;
             } else {
-                ref.role = "";  // Verts, Lines, Polys, Strips, FieldData: not read
+                ref.role = "";  // Verts, Lines, Polys, Strips, FieldData: not read, not checked
+            }
+            if (ref.role.empty()) {
+                if (!tag->self_closing) open.push_back(tag->name);
+                continue;
             }
             const std::string type = attribute(*tag, "type");
             ref.type = find_type(type);
@@ -467,18 +471,13 @@ VtkFile::VtkFile(fs::path path) : path_(std::move(path)) {
             } else {
                 fail(path_, fmt::format("array '{}': unknown format '{}'", shown, ref.format));
             }
-            if (!ref.role.empty()) {
-                const bool listed = ref.role == "point data" || ref.role == "cell data";
-                if (listed) {
-                    const bool duplicate = std::any_of(refs_.begin(), refs_.end(), [&](const ArrayRef& r) {
-                        return r.role == ref.role && r.info.name == ref.info.name;
-                    });
-                    if (duplicate) fail(path_, fmt::format("two arrays named '{}' in the {}", ref.info.name, ref.role));
-                }
-                refs_.push_back(ref);
-            } else if (open_inline != none) {
-                open_inline = none;  // not read: its content is skipped
+            if (ref.role == "point data" || ref.role == "cell data") {
+                const bool duplicate = std::any_of(refs_.begin(), refs_.end(), [&](const ArrayRef& r) {
+                    return r.role == ref.role && r.info.name == ref.info.name;
+                });
+                if (duplicate) fail(path_, fmt::format("two arrays named '{}' in the {}", ref.info.name, ref.role));
             }
+            refs_.push_back(ref);
         } else if (tag->name == "AppendedData") {
             appended_encoding_ = attribute(*tag, "encoding", "raw");
             if (appended_encoding_ != "raw" && appended_encoding_ != "base64") {

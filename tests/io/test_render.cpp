@@ -223,7 +223,7 @@ std::string base64_block(const std::vector<unsigned char>& data, bool together) 
     return base64(all);
 }
 
-TEST(SnapshotReader, ReadsBase64AsciiFloat32AndUInt32HeadersAsVtkWritesThem) {
+TEST(SnapshotReader, ReadsBase64AsciiFloat32AndUInt32HeadersAsParaViewWritesThem) {
     const fs::path dir = fresh_dir("encodings");
     const std::vector<double> points{1e-3, 2e-3, 0, 3e-3, 4e-3, 0, 5e-3, 6e-3, 0};
     const std::vector<float> temperature{300.5f, 301.25f, 302.0f};
@@ -234,7 +234,9 @@ TEST(SnapshotReader, ReadsBase64AsciiFloat32AndUInt32HeadersAsVtkWritesThem) {
     const std::string text =
         "<?xml version=\"1.0\"?>\n<!-- written by hand -->\n"
         "<VTKFile type=\"PolyData\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt32\">\n"
-        "<PolyData><Piece NumberOfPoints=\"3\" NumberOfVerts=\"0\">\n<PointData>\n"
+        "<PolyData>\n<FieldData><DataArray type=\"String\" Name=\"note\" NumberOfTuples=\"1\" format=\"ascii\">104 105 0"
+        "</DataArray></FieldData>\n"  // ParaView's field data: not read
+        "<Piece NumberOfPoints=\"3\" NumberOfVerts=\"0\">\n<PointData>\n"
         "<DataArray type=\"Float32\" Name=\"temperature\" format=\"appended\" offset=\"0\"/>\n"
         "<DataArray type=\"Int32\" Name=\"body\" format=\"appended\" offset=\"" +
         std::to_string(appended_temperature.size()) +
