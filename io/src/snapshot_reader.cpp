@@ -388,6 +388,12 @@ VtkFile& VtkFile::operator=(VtkFile&&) noexcept = default;
 
 VtkFile::VtkFile(fs::path path) : path_(std::move(path)) {
     bytes_ = read_whole_file(path_, "snapshot file");
+    parse();
+}
+
+VtkFile::VtkFile(fs::path name, std::string bytes) : path_(std::move(name)), bytes_(std::move(bytes)) { parse(); }
+
+void VtkFile::parse() {
     XmlScanner xml(bytes_, path_);
     std::vector<std::string> open;  // the elements we are inside
     bool root = false;

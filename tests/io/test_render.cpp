@@ -316,6 +316,43 @@ TEST(SnapshotReader, BadFoldersAndFilesFailNamingTheFileAndTheFault) {
     EXPECT_TRUE(contains(error_of([&] { const VtkFile opened(file); }), "not a VTK XML file"));
 }
 
+TEST(SnapshotReader, AFileCutAnywhereOrWithAByteChangedReadsOrFailsCleanly) {
+    const fs::path dir = fresh_dir("cuts");
+    const NodeStore nodes = sample_nodes(GeometryKind::Axisymmetric, 3);
+    SnapshotSeries(dir).write(nodes, nodes.size(), 0.0);
+    const std::string vtp = read_text(dir / "particles_00000.vtp");
+    // Reading every array of the file: it either works or throws SnapshotError, nothing else.
+    const auto read_all = [&](const std::string& bytes, const std::string& what) {
+        try {
+            const VtkFile f("damaged.vtp", bytes);
+            f.points();
+            for (const auto& a : f.arrays()) f.values(a.name, a.location);
+            return true;
+        } catch (const SnapshotError&) {
+        } catch (const std::exception& e) {
+            ADD_FAILURE() << what << ": " << e.what();
+        }
+        return false;
+    };
+    // The points are the last array read (the vertices after them are not): a cut before the
+    // end of their values loses some value that is read.
+    const std::size_t data = vtp.find('_', vtp.find("<AppendedData")) + 1;
+    const std::size_t points_tag = vtp.find("offset=\"", vtp.find("<Points>")) + 8;
+    const std::size_t points_end = data + std::stoul(vtp.substr(points_tag)) + 8 + 3 * 3 * 8;
+    ASSERT_LT(points_end, vtp.size());
+    for (std::size_t length = 0; length < vtp.size(); length += 3) {
+        const bool read = read_all(vtp.substr(0, length), "cut at " + std::to_string(length));
+        if (length < points_end) {
+            EXPECT_FALSE(read) << "a file cut at byte " << length << " of " << vtp.size() << " was read";
+        }
+    }
+    for (std::size_t at = 0; at < vtp.size(); ++at) {
+        std::string changed = vtp;
+        changed[at] = static_cast<char>(changed[at] ^ 0x5a);
+        read_all(changed, "byte " + std::to_string(at) + " changed");
+    }
+}
+
 // --- Pictures ------------------------------------------------------------------------------
 
 // A folder with one snapshot of `nodes` and, if given, the scene.toml line naming its geometry.

@@ -70,6 +70,8 @@ struct VtkCells {
 class VtkFile {
 public:
     explicit VtkFile(std::filesystem::path path);
+    // The same from the bytes of a file held in memory; `name` stands for the file in messages.
+    VtkFile(std::filesystem::path name, std::string bytes);
     ~VtkFile();
     VtkFile(const VtkFile&);
     VtkFile(VtkFile&&) noexcept;
@@ -99,6 +101,7 @@ private:
     std::vector<double> decode(const ArrayRef& a, std::size_t tuples) const;
     std::vector<std::int64_t> decode_integers(const ArrayRef& a, std::size_t tuples) const;
     std::vector<unsigned char> block(const ArrayRef& a, std::size_t tuples, std::size_t width) const;
+    void parse();
     const ArrayRef& array(std::string_view name, DataLocation location) const;
 
     std::filesystem::path path_;
