@@ -163,10 +163,11 @@ public:
     // Writes everything later steps depend on (every node field, the ghosts, the neighbour lists
     // and their candidates with the positions and diameters of the last search, the scatter
     // plan, both time steps, the half-step kinetic energy, impulses, boundary work, the bookings
-    // of the prescribed velocities, counters, totals and phase times), so that a Simulation built from the same scene and restored from
-    // it continues bit-identically to one never stopped, on any thread count. The file is
-    // versioned and carries build_id(), `scene_fingerprint` (what identifies the scene to the
-    // caller, e.g. a hash of its file) and `user_data` (anything the caller wants back).
+    // of the prescribed velocities, counters, totals and phase times), so that a Simulation built
+    // from the same scene and restored from it continues bit-identically to one never stopped, on
+    // any thread count. The file is versioned and carries build_id(), `scene_fingerprint` (what
+    // identifies the scene to the caller, e.g. a hash of its file) and `user_data` (anything the
+    // caller wants back).
     void save_checkpoint(std::ostream& out, std::string_view scene_fingerprint, std::string_view user_data = {}) const;
     // False for scenes with element bodies: their state is not in the checkpoint format yet, and
     // save_checkpoint refuses them (InputError) rather than write one that would not resume exactly.
