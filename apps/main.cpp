@@ -3,6 +3,8 @@
 //   gpa run --resume DIR [--threads N] [--quiet] [--max-memory SIZE]
 //   gpa study SCENE [-o DIR] [--refine 1,1.5,2] [--variant NAME:key=value,...]... [--threads 1,2] [--overwrite] [-q]
 //   gpa check SCENE [--max-memory SIZE]
+//   gpa render RUN_DIR [--field NAME[:x|y|z]] [-o PNG] [--snapshot N|last | --time T] [--size WxH | --width W]
+//              [--range MIN:MAX] [--mirror | --no-mirror] [--view +y] [--geometry G] [--list] [-q]
 //   gpa materials
 //   gpa demo [--threads N] [-o DIR]
 //   gpa --version
@@ -25,12 +27,13 @@
 #include "gpa/engine/version.hpp"
 #include "gpa/io/output.hpp"
 #include "gpa/io/study.hpp"
+#include "render.hpp"
 #include "run.hpp"
 #include "study.hpp"
 
 namespace {
 
-const std::vector<std::string> commands{"run", "study", "check", "materials", "demo"};
+const std::vector<std::string> commands{"run", "study", "check", "render", "materials", "demo"};
 
 // A whole number of threads, 0 (all hardware threads) to 4096; the message names the value.
 std::string check_threads(const std::string& text) {
@@ -140,6 +143,34 @@ int main(int argc, char** argv) {
     check->add_option("scene", check_file, "scene file")->required();
     check->add_option("--max-memory", memory_text, memory_help)->check(memory_check);
 
+    gpa::app::RenderCommandOptions render_options;
+    std::string render_target, render_output;
+    auto* render = app.add_subcommand("render", "a PNG picture of a snapshot of a run coloured by a field (docs/render.md)");
+    render->add_option("RUN_DIR", render_target, "the run's output folder (or its .pvd file)")->required();
+    render->add_option("-f,--field", render_options.field,
+                       "the field to colour by; a vector's magnitude, or one component as velocity:z (default velocity; "
+                       "--list shows the fields)");
+    render->add_option("-o,--output", render_output, "the PNG file, or a folder for it (default: RUN/<field>-<snapshot>.png)");
+    auto* render_snapshot = render->add_option("--snapshot", render_options.snapshot,
+                                               "the snapshot: its number in the .pvd (from 0) or last (default last)");
+    render->add_option("--time", render_options.time, "the snapshot nearest to this time, e.g. 40us (plain numbers in s)")
+        ->excludes(render_snapshot);
+    auto* render_size = render->add_option("--size", render_options.size, "picture size WIDTHxHEIGHT in pixels, e.g. 1200x900");
+    render->add_option("--width", render_options.width,
+                       "picture width in pixels; the height follows the scene's proportions (default 800)")
+        ->excludes(render_size);
+    render->add_option("--range", render_options.range,
+                       "colour range MIN:MAX in SI units or with a unit (2GPa:5GPa); either end may be left out (default the "
+                       "field's own minimum and maximum)");
+    auto* render_mirror = render->add_flag("--mirror", render_options.mirror, "2D: mirror about x = 0 (default for axisymmetric runs)");
+    render->add_flag("--no-mirror", render_options.no_mirror, "2D: do not mirror an axisymmetric run")->excludes(render_mirror);
+    render->add_option("--view", render_options.view,
+                       "3D: the direction the picture looks along, +x, -x, +y, -y, +z or -z (default +y: x right, z up)");
+    render->add_option("--geometry", render_options.geometry,
+                       "axisymmetric, plane-strain or 3d (default: the run's scene.toml or summary.json)");
+    render->add_flag("--list", render_options.list, "list the snapshots and the fields of the chosen one, and draw nothing");
+    render->add_flag("-q,--quiet", render_options.quiet, "print nothing when the picture is written");
+
     auto* materials = app.add_subcommand("materials", "list the built-in material library");
 
     int demo_threads = 0;
@@ -151,7 +182,7 @@ int main(int argc, char** argv) {
     // A first word that is neither an option nor a command is named (CLI11 would only say that
     // a subcommand is required).
     if (argc > 1 && argv[1][0] != '-' && std::find(commands.begin(), commands.end(), argv[1]) == commands.end()) {
-        fmt::print(stderr, "gpa: unknown command '{}'; the commands are run, study, check, materials and demo (gpa --help)\n",
+        fmt::print(stderr, "gpa: unknown command '{}'; the commands are run, study, check, render, materials and demo (gpa --help)\n",
                    argv[1]);
         return 2;
     }
@@ -188,6 +219,11 @@ int main(int argc, char** argv) {
             return gpa::app::run_study(study_options);
         }
         if (check->parsed()) return gpa::app::check_scene(check_file, memory);
+        if (render->parsed()) {
+            render_options.run = render_target;
+            if (!render_output.empty()) render_options.output = render_output;
+            return gpa::app::render_run(render_options);
+        }
         if (materials->parsed()) return gpa::app::list_materials();
         return gpa::app::run_demo(demo_threads, demo_output);
     } catch (const gpa::InputError& e) {

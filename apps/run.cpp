@@ -272,6 +272,7 @@ public:
     // A fresh run: the scene's copy, the history's header, the snapshot at t = 0, the disk check.
     void start() {
         io::write_text_file(folder_.partial() / scene_copy_name, source_.text);
+        sim_.measure_bodies();
         history_.emplace(folder_.partial() / "history.csv", sim_.totals(), dimension_of(sim_.scene().geometry));
         history_->write(sim_.totals());
         last_row_ = sim_.steps();
@@ -284,6 +285,7 @@ public:
     void resume(std::size_t checkpoint_step) {
         const Scene& scene = sim_.scene();
         const std::size_t every = std::max<std::size_t>(scene.output.history_every, 1);
+        sim_.measure_bodies();
         history_.emplace(folder_.partial() / "history.csv", sim_.totals(), dimension_of(scene.geometry),
                          [&](std::size_t step) { return step <= checkpoint_step && step % every == 0; });
         last_row_ = checkpoint_step;
@@ -354,6 +356,7 @@ public:
 
 private:
     void write_row() {
+        sim_.measure_bodies();  // the summary reports the bodies as of the last row too
         history_->write(sim_.totals());
         last_row_ = sim_.steps();
     }

@@ -9,6 +9,7 @@ packages=(
   libtbb-dev libeigen3-dev libfmt-dev libspdlog-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev libtomlplusplus-dev nlohmann-json3-dev
+  libpng-dev   # gpa render: PNG pictures of snapshots
   clang libclang-rt-14-dev llvm   # scripts/sanitize.sh: sanitizers, libFuzzer, llvm-symbolizer
 )
 if [[ "${1:-}" == "--with-peers" ]]; then

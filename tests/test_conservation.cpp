@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <random>
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
@@ -230,6 +231,54 @@ TEST_P(Conservation, WithBondViscosityTheDifferenceIsTheBondTerm) {
     const ForceCase s = GetParam();
     const BondViscosityParameters bond{0.2, 4.0, 0.01};
     dispatch_geometry(s.geometry, [&](auto g) { check_energy<decltype(g)>(s, &bond); });
+}
+
+// The compatible energy update (spec section 5): the stress power of every centre, evaluated at a
+// velocity field w other than the one the gradient saw, adds up to the power of the engine's
+// forces at w, and its viscous part is Q_i V_i tr L_i(w) (+ Q_i V_i w_x / x_i).
+template <class G>
+void check_stress_power(const ForceCase& s) {
+    constexpr int D = G::dim;
+    auto e = evaluate<G>(s, nullptr);
+    auto& n = e.nodes;
+    std::mt19937_64 rng(11);
+    std::uniform_real_distribution<double> u(-100.0, 100.0);
+    std::array<std::vector<double>, 3> w;
+    std::array<const double*, D> wp{};
+    for (int c = 0; c < D; ++c) {
+        w[c].resize(n.size());
+        for (auto& x : w[c]) x = u(rng);
+        wp[c] = w[c].data();
+    }
+    std::vector<double> power(n.size()), viscous(n.size());
+    auto f = force_fields<D>(n, a);
+    compute_stress_power<G>(e.lists, s.weight, f, wp, n.size(), power.data(), viscous.data());
+    double sum = 0.0, force_power = 0.0, scale = 0.0;
+    for (std::size_t i = 0; i < n.size(); ++i) {
+        sum += power[i];
+        for (int c = 0; c < D; ++c) {
+            force_power += n.force[c][i] * w[c][i];
+            scale += std::abs(n.force[c][i] * w[c][i]);
+        }
+    }
+    EXPECT_NEAR(sum, force_power, 1e-12 * scale) << name(s);
+    // The viscous part from the velocity gradient of w (the gradient kernel, not the power kernel).
+    for (int c = 0; c < D; ++c) std::copy(w[c].begin(), w[c].end(), n.velocity[c].begin());
+    auto g = gradient_fields<D>(n, a);
+    compute_velocity_gradient<G>(e.lists, s.weight, g);
+    for (std::size_t i = 0; i < n.size(); ++i) {
+        double trace = 0.0;
+        for (int c = 0; c < D; ++c) trace += n.velocity_gradient[c * D + c][i];
+        if constexpr (G::axisymmetric) trace += w[0][i] / n.position[0][i];
+        const double expected = n.viscous_pressure[i] * n.volume[i] * trace;
+        ASSERT_NEAR(viscous[i], expected, 1e-12 * (std::abs(expected) + n.viscous_pressure[i] * n.volume[i] * 1e4))
+            << name(s) << " node " << i;
+    }
+}
+
+TEST_P(Conservation, StressPowerAtOtherVelocitiesIsTheForcePowerThere) {
+    const ForceCase s = GetParam();
+    dispatch_geometry(s.geometry, [&](auto g) { check_stress_power<decltype(g)>(s); });
 }
 
 INSTANTIATE_TEST_SUITE_P(AllGeometries, Conservation, ::testing::ValuesIn(setups()),

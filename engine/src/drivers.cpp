@@ -233,7 +233,49 @@ void forces_impl(const CompressedRows& lists, const ScatterPlan& plan, const Bon
     }
 }
 
+template <class G, class W>
+void stress_power_impl(const CompressedRows& lists, const ForceFields<G::dim>& f,
+                       const std::array<const double*, G::dim>& velocity, std::size_t n, double* power,
+                       double* viscous_power) {
+    constexpr int D = G::dim;
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024), [&](const tbb::blocked_range<std::size_t>& range) {
+        for (std::size_t i = range.begin(); i != range.end(); ++i) {
+            const Mat<D> sigma = cauchy_stress<G>(f.deviatoric_stress, f.pressure, f.viscous_pressure, i);
+            const Mat<D> normalisation = f.full_normalisation ? normalisation_of<D>(f.alpha, f.alpha_shear, i)
+                                                              : Mat<D>(load<D>(f.alpha, i).asDiagonal());
+            const double q = f.viscous_pressure ? f.viscous_pressure[i] : 0.0;
+            const double volume = f.volume[i];
+            const Vec<D> v_i = load<D>(velocity, i);
+            double sum = 0.0, divergence = 0.0;
+            for (NodeIndex j : lists.row(i)) {
+                const auto p = f.pairs.template pair<W>(i, j);
+                const Vec<D> n = normalisation * p.l;
+                const Vec<D> dv = load<D>(velocity, j) - v_i;
+                sum += pair_force(p, volume, f.size_weight[j], n, sigma, 0.0).dot(dv);  // Eq. 21-22
+                divergence += p.R * f.size_weight[j] * p.inv_r * n.dot(dv);
+            }
+            if constexpr (G::axisymmetric) {
+                const double hoop = hoop_force(out_of_plane_stress(f.deviatoric_stress, f.pressure, f.viscous_pressure, i), volume,
+                                               f.pairs.position[0][i]);
+                sum += hoop * v_i[0];
+                divergence += v_i[0] / f.pairs.position[0][i];
+            }
+            power[i] = sum;
+            viscous_power[i] = q * volume * divergence;
+        }
+    });
+}
+
 }  // namespace
+
+template <class G>
+void compute_stress_power(const CompressedRows& lists, WeightKind weight, const ForceFields<G::dim>& f,
+                          const std::array<const double*, G::dim>& velocity, std::size_t real_count, double* power,
+                          double* viscous_power) {
+    dispatch_weight(weight, [&](auto w) {
+        stress_power_impl<G, decltype(w)>(lists, f, velocity, real_count, power, viscous_power);
+    });
+}
 
 template <class G>
 void compute_velocity_gradient(const CompressedRows& lists, WeightKind weight, const GradientFields<G::dim>& f,
@@ -272,6 +314,12 @@ void compute_forces(const CompressedRows& lists, const ScatterPlan& plan, Weight
     });
 }
 
+template void compute_stress_power<PlaneStrain>(const CompressedRows&, WeightKind, const ForceFields<2>&,
+                                          const std::array<const double*, 2>&, std::size_t, double*, double*);
+template void compute_stress_power<Axisymmetric>(const CompressedRows&, WeightKind, const ForceFields<2>&,
+                                          const std::array<const double*, 2>&, std::size_t, double*, double*);
+template void compute_stress_power<ThreeD>(const CompressedRows&, WeightKind, const ForceFields<3>&,
+                                          const std::array<const double*, 3>&, std::size_t, double*, double*);
 template void compute_velocity_gradient<PlaneStrain>(const CompressedRows&, WeightKind,
                                                 const GradientFields<PlaneStrain::dim>&, std::size_t);
 template void compute_forces<PlaneStrain>(const CompressedRows&, const ScatterPlan&, WeightKind,

@@ -198,6 +198,18 @@ void GhostSet::update(NodeStore& nodes, std::size_t real_count) const {
     });
 }
 
+void GhostSet::mirror_vector_field(const std::array<double*, 3>& field, int dim, std::size_t real_count) const {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, source_.size(), 2048), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t k = r.begin(); k != r.end(); ++k) {
+            const std::size_t g = real_count + k, s = source_[k];
+            for (int c = 0; c < dim; ++c) field[c][g] = field[c][s];
+            for (std::size_t p = 0; p < planes_.size(); ++p) {
+                if ((mask_[k] >> p) & 1u) field[planes_[p].axis][g] = -field[planes_[p].axis][g];
+            }
+        }
+    });
+}
+
 bool GhostSet::covers(const NodeStore& nodes, std::size_t real_count, double range) const {
     if (planes_.empty()) return true;
     for (std::size_t slot = 0; slot < masks_.size(); ++slot) {

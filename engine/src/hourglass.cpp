@@ -65,17 +65,24 @@ void apply_hourglass_control(const CompressedRows& lists, const ScatterPlan& pla
         // Pass 2: F_j = - kappa w_j e_ij on the neighbour, the reaction on the centre.
         Vec<D> on_centre = Vec<D>::Zero();
         double power = 0.0;
+        const bool other_velocity = f.power_velocity[0] != nullptr;
+        [[maybe_unused]] Vec<D> w_i;
+        if (other_velocity) w_i = load(f.power_velocity, i);
         for (NodeIndex j : lists.row(i)) {
             if (!controlled_pair(i, j)) continue;
             const Vec<D> r = load(f.position, j) - x_i;
             const Vec<D> dv = load(f.velocity, j) - v_i;
             const Vec<D> force_on_j = (-kappa * hourglass_pair_weight(f.size_weight[j], r.squaredNorm())) *
                                       hourglass_velocity_error<D>(fitted_gradient, r, dv);
-            for (int c = 0; c < D; ++c) f.force[c][j] += force_on_j[c];
+            if (f.force[0]) {
+                for (int c = 0; c < D; ++c) f.force[c][j] += force_on_j[c];
+            }
             on_centre -= force_on_j;
-            power += force_on_j.dot(dv);
+            power += force_on_j.dot(other_velocity ? (load(f.power_velocity, j) - w_i).eval() : dv);
         }
-        for (int c = 0; c < D; ++c) f.force[c][i] += on_centre[c];
+        if (f.force[0]) {
+            for (int c = 0; c < D; ++c) f.force[c][i] += on_centre[c];
+        }
         f.power[i] = power;
     };
     for (std::size_t colour = 0; colour < plan.colours(); ++colour) {

@@ -136,6 +136,7 @@ void update_stresses(NodeStore& nodes, std::size_t real_count, const std::vector
                 inc.density_new = density_new;
                 inc.viscous_pressure_old = nodes.viscous_pressure[i];
                 inc.viscous_pressure_new = q_new;
+                inc.energy_booked_by_caller = options.energy_booked_by_forces;
                 inc.failure_enabled = options.failure;
                 try {
                     advance_material_point<D>(fields, i, material, inc);

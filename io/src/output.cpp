@@ -70,6 +70,36 @@ namespace {
 
 char component_letter(int dim, int c) { return dim == 2 ? (c == 0 ? 'x' : 'z') : "xyz"[c]; }
 
+// Per-body columns, for scenes of more than one body (body_report.hpp defines them).
+std::string body_columns(const Totals& t, int dim) {
+    if (t.bodies.size() < 2) return {};
+    const char* const axes2[] = {"x", "z"};
+    const char* const axes3[] = {"x", "y", "z"};
+    std::string h;
+    for (const auto& b : t.bodies) {
+        const std::string& n = b.name;
+        h += fmt::format(",{0}_kinetic_energy_J,{0}_internal_energy_J", n);
+        for (int c = 0; c < dim; ++c) h += fmt::format(",{}_momentum_{}_kg_m_s", n, dim == 3 ? axes3[c] : axes2[c]);
+        for (int c = 0; c < dim; ++c) h += fmt::format(",{}_velocity_{}_m_s", n, dim == 3 ? axes3[c] : axes2[c]);
+        h += fmt::format(",{0}_residual_velocity_m_s,{0}_pieces,{0}_failed_nodes", n);
+        if (b.target) h += fmt::format(",{0}_crater_depth_m,{0}_crater_diameter_m,{0}_perforated", n);
+    }
+    return h;
+}
+
+std::string body_values(const Totals& t, int dim) {
+    if (t.bodies.size() < 2) return {};
+    std::string r;
+    for (const auto& b : t.bodies) {
+        r += fmt::format(",{:.9e},{:.9e}", b.kinetic_energy, b.internal_energy);
+        for (int c = 0; c < dim; ++c) r += fmt::format(",{:.9e}", b.momentum[c]);
+        for (int c = 0; c < dim; ++c) r += fmt::format(",{:.9e}", b.centre_velocity[c]);
+        r += fmt::format(",{:.9e},{},{}", b.residual_speed_along_axis, b.pieces, b.failed_nodes);
+        if (b.target) r += fmt::format(",{:.9e},{:.9e},{}", b.crater_depth, b.crater_diameter, b.perforated ? 1 : 0);
+    }
+    return r;
+}
+
 std::string history_header(const Totals& first, int dim) {
     std::string header =
         "time_s,dt_s,step,kinetic_energy_J,internal_energy_J,plastic_work_J,viscous_work_J,boundary_work_J,"
@@ -87,8 +117,9 @@ std::string history_header(const Totals& first, int dim) {
         }
         header += fmt::format(",{}_work_J", name);
     }
-    header += ",real_nodes,ghost_nodes,variable_nodes,failed_nodes,neighbour_pairs,element_nodes,elements\n";
-    return header;
+    header += ",real_nodes,ghost_nodes,variable_nodes,failed_nodes,neighbour_pairs,element_nodes,elements";
+    header += body_columns(first, dim);
+    return header + "\n";
 }
 
 }  // namespace
@@ -166,9 +197,10 @@ void HistoryWriter::write(const Totals& t) {
         }
         row += fmt::format(",{:.9e}", r.work);
     }
-    row += fmt::format(",{},{},{},{},{},{},{}\n", t.real_nodes, t.ghost_nodes, t.variable_nodes, t.failed_nodes, t.pairs,
+    row += fmt::format(",{},{},{},{},{},{},{}", t.real_nodes, t.ghost_nodes, t.variable_nodes, t.failed_nodes, t.pairs,
                        t.element_nodes, t.elements);
-    append(row);
+    row += body_values(t, dim_);
+    append(row + "\n");
 }
 
 SnapshotSeries::SnapshotSeries(fs::path folder, std::string stem) : folder_(std::move(folder)), stem_(std::move(stem)) {}
@@ -323,6 +355,32 @@ void write_summary(const fs::path& file, const Simulation& sim, const RunSummary
                                components(r.reaction), components(r.impulse), json_number(r.work));
     }
     field("prescribed_velocities", regions + "]");
+    std::string bodies = "[";
+    for (std::size_t k = 0; k < t.bodies.size(); ++k) {
+        const auto& b = t.bodies[k];
+        const auto vec = [&](const std::array<double, 3>& v) {
+            std::string s = "[";
+            for (int c = 0; c < dim; ++c) s += fmt::format("{}{}", c ? ", " : "", json_number(v[c]));
+            return s + "]";
+        };
+        bodies += fmt::format(
+            "{}{{\"name\": {}, \"nodes\": {}, \"failed_nodes\": {}, \"mass_kg\": {}, \"kinetic_energy_J\": {}, "
+            "\"internal_energy_J\": {}, \"momentum_kg_m_s\": {}, \"centre_velocity_m_s\": {}",
+            k ? ",\n    " : "", json_string(b.name), b.nodes, b.failed_nodes, json_number(b.mass), json_number(b.kinetic_energy),
+            json_number(b.internal_energy), vec(b.momentum), vec(b.centre_velocity));
+        if (b.measured) {
+            bodies += fmt::format(", \"pieces\": {}, \"main_piece_mass_kg\": {}, \"residual_velocity_m_s\": {}, "
+                                  "\"residual_speed_along_impact_m_s\": {}",
+                                  b.pieces, json_number(b.main_piece_mass), vec(b.residual_velocity),
+                                  json_number(b.residual_speed_along_axis));
+            if (b.target) {
+                bodies += fmt::format(", \"crater_depth_m\": {}, \"crater_diameter_m\": {}, \"perforated\": {}",
+                                      json_number(b.crater_depth), json_number(b.crater_diameter), b.perforated ? "true" : "false");
+            }
+        }
+        bodies += "}";
+    }
+    field("bodies", bodies + "]");
     std::string refs = "[";
     const auto comparisons = compare_with_reference(sim);
     for (std::size_t k = 0; k < comparisons.size(); ++k) {

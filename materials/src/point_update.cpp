@@ -126,7 +126,11 @@ PointResult update_point(const Material& m, PointState& state, const PointIncrem
     }
     double energy = (known - 0.5 * eos.a * dv) / denominator;
     double pressure = eos.a + eos.b * energy;
-    if (state.failed && pressure < 0.0) {
+    if (inc.energy_booked_by_caller) {
+        energy = state.specific_internal_energy;
+        pressure = eos.a + eos.b * energy;
+        if (state.failed && pressure < 0.0) pressure = 0.0;
+    } else if (state.failed && pressure < 0.0) {
         pressure = 0.0;
         energy = known;
     }
@@ -167,7 +171,7 @@ PointResult update_point(const Material& m, PointState& state, const PointIncrem
     const double shear = (state.failed || molten) ? 0.0 : m.shear_modulus;
     result.sound_speed = std::sqrt((k_s + 4.0 * shear / 3.0) / rho_new);
     result.plastic_work = plastic_work;
-    result.viscous_work = -q_mid * dv;
+    result.viscous_work = inc.energy_booked_by_caller ? 0.0 : -q_mid * dv;
     result.plastic_strain_rate = plastic_rate;
     return result;
 }

@@ -99,7 +99,7 @@ grep -q '"status": "finished"' conc/summary.json || fail "the first run's summar
 [[ -e conc.lock || -e conc.partial ]] && fail "the first run left conc.lock or conc.partial"
 
 # --- the energy guard ------------------------------------------------------------------------
-variant cfl1.toml -e 's/^\[stop\]/[solver]\ncfl = 1.0\n\n[stop]/' -e 's/^max_steps = 20/max_steps = 2000/'
+variant cfl1.toml -e 's/^\[stop\]/[solver]\ncfl = 1.0\nenergy_update = "point"\n\n[stop]/' -e 's/^max_steps = 20/max_steps = 2000/'
 expect 3 "cfl = 1" -- "$gpa" run cfl1.toml -o cfl1 -q
 for word in "step " " us, phase \"totals\"" "node " "of body \"bar\"" "field total energy" "exceeds stop.energy_error = 3 %"; do
   says err.txt "$word" "energy guard message"

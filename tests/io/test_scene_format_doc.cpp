@@ -101,6 +101,8 @@ TEST(SceneFormatDoc, DefaultsAreThoseOfSceneHpp) {
     expect_number(doc, "max_time_step", s.max_time_step);
     expect_number(doc, "time_step_growth", s.time_step_growth);
     expect_word(doc, "failure", s.failure ? "true" : "false");
+    expect_word(doc, "separate_failed", s.separate_failed ? "true" : "false");
+    expect_word(doc, "energy_update", s.energy_update == EnergyUpdate::Compatible ? "\"compatible\"" : "\"point\"");
     expect_word(doc, "scatter", word(s.scatter));
     expect_number(doc, "reorder_interval", static_cast<double>(s.reorder_interval));
     expect_number(doc, "neighbour_skin", s.neighbour_skin);
@@ -119,9 +121,9 @@ TEST(SceneFormatDoc, DefaultsAreThoseOfSceneHpp) {
     EXPECT_EQ(o.checkpoint_every_steps, 0u);
     expect_word(doc, "checkpoint_every", fmt::format("\"{:g} min\"", o.checkpoint_every_seconds / 60.0));
 
-    // 20 solver options, 4 stop criteria, 4 output options, and no row for an option that does
+    // 22 solver options, 4 stop criteria, 4 output options, and no row for an option that does
     // not exist.
-    EXPECT_EQ(doc.size(), 28u) << "rows in [solver], [stop] and [output] of docs/scene-format.md";
+    EXPECT_EQ(doc.size(), 30u) << "rows in [solver], [stop] and [output] of docs/scene-format.md";
 }
 
 }  // namespace

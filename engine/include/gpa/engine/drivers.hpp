@@ -38,4 +38,18 @@ void compute_forces(const CompressedRows& lists, const ScatterPlan& plan, Weight
                     const BondViscosityParameters* bond, const ForceFields<G::dim>& f,
                     std::size_t node_count);
 
+// The power of each real centre's stress forces at the velocities v (spec section 5, "[spec]
+// Compatible energy"): for centre i,
+//   power_i = sum_j P(ij) . (v_j - v_i)  (+ P_x(ii) v_x,i, the hoop force, in axisymmetric geometry)
+//           = - V_i sigma_i : L_i(v)   (Eq. 21-24 and the energy identity of section 5),
+// with P(ij) the force of Eq. 21-22 from sigma_i = s_i - (P_i + Q_i) I (no bond viscosity), and
+// viscous_power_i its -Q_i I part alone. Called with the mean of the half-step velocities on both
+// sides of a velocity update, sum_i power_i dt is the kinetic energy the stress forces add in that
+// update, to round-off, so booking -power_i dt as internal energy of i conserves energy exactly.
+// `velocity` covers ghosts too (mirrored like the velocities themselves).
+template <class G>
+void compute_stress_power(const CompressedRows& lists, WeightKind weight, const ForceFields<G::dim>& f,
+                          const std::array<const double*, G::dim>& velocity, std::size_t real_count, double* power,
+                          double* viscous_power);
+
 }  // namespace gpa

@@ -6,6 +6,7 @@
 // the mirrored position, velocity and stress. Ghosts act on real nodes as centres and as
 // neighbours; they are not integrated, and the forces on them are the planes' reactions.
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -46,6 +47,10 @@ public:
     // the same ghost pairs (and the energy identity holds). (A rigid plane without lift-off is,
     // as spec section 7 says, a symmetry plane: its ghost pairs always act.)
     void update_contacts(NodeStore& nodes, std::size_t real_count, bool initial) const;
+
+    // Gives the ghost entries (real_count onwards) of a vector field the mirrored values of their
+    // sources, as update() does for the velocities; `field` holds real and ghost nodes.
+    void mirror_vector_field(const std::array<double*, 3>& field, int dim, std::size_t real_count) const;
 
 
     // Replaces the ghosts of `nodes` (everything after real_count) with the mirrors of the real

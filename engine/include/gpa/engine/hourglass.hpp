@@ -30,8 +30,12 @@ struct HourglassFields {
     // this (the lattice regime, where the mode lives: see apply_hourglass_control); fixed ones always.
     double lattice_plastic_strain = 0.0;
     // outputs
-    std::array<double*, D> force{};  // added to
+    std::array<double*, D> force{};  // added to; all null: only the power is computed
     double* power = nullptr;         // per centre: the power of its control forces (<= 0), W
+    // Optional: the power is that of the forces (made from `velocity`) at these velocities instead,
+    // sum_j F_j . (w_j - w_i); the compatible energy update books the heat at the mean velocities of
+    // the velocity update (docs/energy.md).
+    std::array<const double*, D> power_velocity{};
 };
 
 template <int D>

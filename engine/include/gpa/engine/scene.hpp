@@ -121,6 +121,12 @@ struct PrescribedVelocitySpec {
     double ramp = 0.0;                              // s
 };
 
+// How the internal energy follows the stress (spec section 5, "[spec] Compatible energy").
+enum class EnergyUpdate {
+    Compatible,  // the work of each node's stress forces at the mean velocities of the velocity update
+    Point,       // the point update's own mid-step energy equation (materials.md; not exactly conservative)
+};
+
 struct SolverOptions {
     ConnectivityMode connectivity = ConnectivityMode::Variable;
     double switch_plastic_strain = 0.1;  // Automatic: switch at this equivalent plastic strain
@@ -147,6 +153,10 @@ struct SolverOptions {
     double max_time_step = std::numeric_limits<double>::infinity();  // s
     double time_step_growth = 1.1;       // largest ratio of one step to the previous
     bool failure = false;                // apply the materials' failure models (J-C damage, spall)
+    // With failure: a pair with a failed node may open like a pair between bodies (separation.hpp),
+    // so that a crack has free faces; false keeps such pairs like any other.
+    bool separate_failed = true;
+    EnergyUpdate energy_update = EnergyUpdate::Compatible;
     ScatterScheme scatter = ScatterScheme::Slabs;
     std::size_t reorder_interval = 200;  // steps between locality reorderings (0 = never)
     // Neighbour lists with a skin (Verlet lists): the search keeps every pair within

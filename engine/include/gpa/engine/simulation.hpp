@@ -34,6 +34,7 @@
 #include <string_view>
 #include <vector>
 
+#include "gpa/engine/body_report.hpp"
 #include "gpa/engine/compressed_rows.hpp"
 #include "gpa/engine/limits.hpp"
 #include "gpa/engine/node_store.hpp"
@@ -65,7 +66,10 @@ struct RegionReport {
     // (smoothing.hpp), N s.
     std::array<double, 3> impulse{0, 0, 0};
     // The work it has done on the bodies since t = 0 (the time integral of reaction . velocity,
-    // prescribed.hpp), J; the energy balance books it as boundary work of the opposite sign.
+    // prescribed.hpp), J, up to the instant of the energy balance's kinetic energy: through the
+    // last velocity update (half a step ahead, like the impulse) with the compatible energy update
+    // of particle bodies, up to t^{n+1} otherwise. The balance books it as boundary work of the
+    // opposite sign.
     double work = 0.0;
 };
 
@@ -89,6 +93,9 @@ struct Totals {
                                               // (the axial component is the meaningful one in axisymmetric)
     std::vector<PlaneReport> planes;          // rigid planes, scene order
     std::vector<RegionReport> regions;        // prescribed-velocity regions, scene order
+    // Every body of the scene, scene order (element bodies carry zeros): energies and momentum every
+    // step; pieces, residual velocity and crater (body_report.hpp) as of the last measure_bodies().
+    std::vector<BodyTotals> bodies;
     // Final length and footprint against the first rigid plane, by the rules of measure.hpp
     // (docs/measurement.md): particles reach d/2 beyond their centres, element nodes lie on the
     // boundary.
@@ -140,6 +147,10 @@ public:
     const NodeStore& nodes() const;
     std::size_t real_count() const;
     const Totals& totals() const;
+    // Measures the bodies' pieces, residual velocities and craters (body_report.hpp) from the
+    // current state into totals().bodies; the run program calls it before every history row and the
+    // summary (it is a union-find over the lists, too much to do every step).
+    void measure_bodies();
     double time() const;
     std::size_t steps() const;
     // The time step the next step() advances by (dt^{n+1/2}; totals().time_step is the last one taken).

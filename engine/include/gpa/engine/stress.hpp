@@ -21,6 +21,9 @@ struct StressPhaseOptions {
     double viscosity_linear = 0.2;
     double viscosity_quadratic = 4.0;
     bool failure = false;
+    // The engine books the stress work after the velocity update (compatible energy): the point
+    // update keeps e and reads its pressure from the EOS at the new density.
+    bool energy_booked_by_forces = false;
 };
 
 // Advances nodes [0, real_count) over dt from the velocity gradient of the gradient phase.

@@ -143,6 +143,10 @@ struct PointIncrement {
     double density_old = 0.0, density_new = 0.0;                    // kg/m^3, at the start and end of the step
     double viscous_pressure_old = 0.0, viscous_pressure_new = 0.0;  // artificial viscosity Q at both ends, Pa
     bool failure_enabled = false;                                   // apply the material's failure models
+    // The caller books the work of the stress itself (the engine's compatible energy update, spec
+    // section 5 "[spec] Compatible energy"): the point keeps its specific internal energy and takes
+    // its end pressure from the EOS at (rho_new, e); plastic work, temperature and damage as usual.
+    bool energy_booked_by_caller = false;
 };
 
 struct PointResult {

@@ -1,0 +1,32 @@
+#pragma once
+// The `gpa render` command: a PNG picture of one snapshot of a run folder coloured by a field
+// (gpa/io/render.hpp draws it), or with --list the snapshots and fields there are.
+
+#include <filesystem>
+#include <optional>
+#include <string>
+
+namespace gpa::app {
+
+struct RenderCommandOptions {
+    std::filesystem::path run;     // a run's output folder, or its .pvd
+    std::string field = "velocity";
+    std::optional<std::filesystem::path> output;  // none: <run>/<field>-<snapshot label>.png
+    std::string snapshot;          // "N", "last" or "" (the last)
+    std::string time;              // "40 us", "4e-5": the snapshot nearest to it
+    std::string size;              // "WxH", as typed
+    int width = 0;                 // --width; 0: the default
+    std::string range;             // "MIN:MAX", either side may be empty (the field's own)
+    bool mirror = false, no_mirror = false;
+    std::string view;              // 3D: "+y", "-z", ...
+    std::string geometry;          // override: axisymmetric, plane-strain, 3d
+    bool list = false;
+    bool quiet = false;
+};
+
+// Returns the exit code: 0 written (or listed). Bad options, a folder or file that cannot be
+// read, an unknown field throw gpa::InputError (exit 2 in main); a picture that cannot be
+// written throws gpa::io::OutputError.
+int render_run(const RenderCommandOptions& options);
+
+}  // namespace gpa::app

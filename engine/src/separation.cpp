@@ -1,0 +1,89 @@
+#include "gpa/engine/separation.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+namespace gpa {
+
+namespace {
+
+// n . sigma . n r^2 for n r = dx: the normal Cauchy stress of node i across a pair, times r^2
+// (only its sign and the sum over both ends matter). Stress components in NodeStore order: 2D
+// xx, zz, xz (theta-theta is out of plane); 3D xx, yy, zz, yz, xz, xy.
+double normal_stress_r2(const NodeStore& nodes, std::size_t i, const std::array<double, 3>& dx) {
+    const auto& s = nodes.deviatoric_stress;
+    const double p = nodes.pressure[i] + nodes.viscous_pressure[i];
+    if (nodes.dim() == 2) {
+        const double xx = s[0][i] - p, zz = s[1][i] - p, xz = s[2][i];
+        return dx[0] * dx[0] * xx + dx[1] * dx[1] * zz + 2.0 * dx[0] * dx[1] * xz;
+    }
+    const double xx = s[0][i] - p, yy = s[1][i] - p, zz = s[2][i] - p;
+    const double yz = s[3][i], xz = s[4][i], xy = s[5][i];
+    return dx[0] * dx[0] * xx + dx[1] * dx[1] * yy + dx[2] * dx[2] * zz +
+           2.0 * (dx[1] * dx[2] * yz + dx[0] * dx[2] * xz + dx[0] * dx[1] * xy);
+}
+
+bool separable(const NodeStore& nodes, std::size_t i, std::size_t j, bool failed_pairs_separate) {
+    return nodes.body[i] != nodes.body[j] || (failed_pairs_separate && (nodes.failed[i] || nodes.failed[j]));
+}
+
+// Both factors are formed from x_j - x_i and v_j - v_i, whose negatives give the same products, and
+// the two stresses are added in a fixed order of the node numbers: the answer is the same from either end.
+bool opening(const NodeStore& nodes, std::size_t i, std::size_t j) {
+    const int d = nodes.dim();
+    std::array<double, 3> dx{};
+    double approach = 0.0;
+    for (int c = 0; c < d; ++c) {
+        dx[c] = nodes.position[c][j] - nodes.position[c][i];
+        approach += (nodes.velocity[c][j] - nodes.velocity[c][i]) * dx[c];
+    }
+    if (approach < 0.0) return false;
+    const std::size_t lo = i < j ? i : j, hi = i < j ? j : i;
+    return normal_stress_r2(nodes, lo, dx) + normal_stress_r2(nodes, hi, dx) >= 0.0;
+}
+
+}  // namespace
+
+bool pair_is_open(const NodeStore& nodes, std::size_t i, std::size_t j, bool failed_pairs_separate) {
+    return separable(nodes, i, j, failed_pairs_separate) && opening(nodes, i, j);
+}
+
+SeparationCounts remove_open_pairs(CompressedRows& lists, const NodeStore& nodes, std::size_t real_count,
+                                   bool failed_pairs_separate, double* closing_speed) {
+    // One pass in place (the rows only shrink); most entries are a body and a failed flag compared.
+    SeparationCounts counts;
+    const int d = nodes.dim();
+    std::size_t out = 0, start = 0;
+    for (std::size_t i = 0; i < real_count; ++i) {
+        const std::size_t end = lists.offsets[i + 1];
+        double closing = 0.0;
+        for (std::size_t e = start; e < end; ++e) {
+            const NodeIndex j = lists.indices[e];
+            if (separable(nodes, i, j, failed_pairs_separate)) {
+                if (opening(nodes, i, j)) {
+                    ++counts.open;
+                    continue;
+                }
+                ++counts.closed;
+                if (closing_speed) {
+                    double dv_dx = 0.0, r2 = 0.0;
+                    for (int c = 0; c < d; ++c) {
+                        const double dx = nodes.position[c][j] - nodes.position[c][i];
+                        dv_dx += (nodes.velocity[c][j] - nodes.velocity[c][i]) * dx;
+                        r2 += dx * dx;
+                    }
+                    if (dv_dx < 0.0 && r2 > 0.0) closing = std::max(closing, -dv_dx / std::sqrt(r2));
+                }
+            }
+            lists.indices[out++] = j;
+        }
+        start = end;
+        lists.offsets[i + 1] = out;
+        if (closing_speed) closing_speed[i] = closing;
+    }
+    lists.indices.resize(out);
+    return counts;
+}
+
+}  // namespace gpa

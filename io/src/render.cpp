@@ -1,0 +1,804 @@
+// Pictures of snapshots (render.hpp): the snapshot's nodes and cells become discs and triangles
+// in the picture plane, the frame fits them into the plot area at one scale in both directions,
+// and they are filled pixel by pixel (a pixel belongs to a shape when its centre lies inside),
+// then the colour bar, the text and the length scale are drawn around them.
+
+#include "gpa/io/render.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+
+#include <fmt/format.h>
+#include <png.h>
+
+#include "bitmap_font.hpp"
+#include "gpa/io/atomic_file.hpp"
+
+namespace gpa::io {
+
+namespace fs = std::filesystem;
+
+// --- Image -------------------------------------------------------------------------------------
+
+Image::Image(int w, int h, Rgb fill) : width(w), height(h), rgb(static_cast<std::size_t>(w) * h * 3) {
+    for (std::size_t k = 0; k < rgb.size(); k += 3) {
+        rgb[k] = fill.r;
+        rgb[k + 1] = fill.g;
+        rgb[k + 2] = fill.b;
+    }
+}
+
+Rgb Image::at(int x, int y) const {
+    const std::size_t k = (static_cast<std::size_t>(y) * width + x) * 3;
+    return {rgb[k], rgb[k + 1], rgb[k + 2]};
+}
+
+void Image::set(int x, int y, Rgb c) {
+    if (x < 0 || y < 0 || x >= width || y >= height) return;
+    const std::size_t k = (static_cast<std::size_t>(y) * width + x) * 3;
+    rgb[k] = c.r;
+    rgb[k + 1] = c.g;
+    rgb[k + 2] = c.b;
+}
+
+// --- Colour map --------------------------------------------------------------------------------
+
+Rgb colour_map(double t) {
+    // Nine stops, interpolated linearly in sRGB; their CIE L* rises from 15 to 91 in steps of
+    // 4 to 6 per sixteenth (checked by the tests).
+    struct Stop {
+        double t;
+        double r, g, b;
+    };
+    static constexpr std::array<Stop, 9> stops{{{0.000, 68, 1, 84},
+                                                {0.125, 71, 44, 123},
+                                                {0.250, 59, 82, 139},
+                                                {0.375, 44, 113, 142},
+                                                {0.500, 33, 145, 140},
+                                                {0.625, 39, 173, 129},
+                                                {0.750, 94, 201, 98},
+                                                {0.875, 170, 220, 50},
+                                                {1.000, 253, 231, 37}}};
+    if (!(t > 0.0)) t = 0.0;  // NaN too
+    if (t > 1.0) t = 1.0;
+    std::size_t k = 0;
+    while (k + 2 < stops.size() && t > stops[k + 1].t) ++k;
+    const Stop& a = stops[k];
+    const Stop& b = stops[k + 1];
+    const double f = (t - a.t) / (b.t - a.t);
+    const auto mix = [f](double x, double y) { return static_cast<std::uint8_t>(std::lround(x + (y - x) * f)); };
+    return {mix(a.r, b.r), mix(a.g, b.g), mix(a.b, b.b)};
+}
+
+// --- Views -------------------------------------------------------------------------------------
+
+std::optional<ViewDirection> view_direction_named(std::string_view text) {
+    if (text == "+x" || text == "x") return ViewDirection::PlusX;
+    if (text == "-x") return ViewDirection::MinusX;
+    if (text == "+y" || text == "y") return ViewDirection::PlusY;
+    if (text == "-y") return ViewDirection::MinusY;
+    if (text == "+z" || text == "z") return ViewDirection::PlusZ;
+    if (text == "-z") return ViewDirection::MinusZ;
+    return std::nullopt;
+}
+
+std::string_view name_of(ViewDirection v) {
+    switch (v) {
+        case ViewDirection::PlusX: return "+x";
+        case ViewDirection::MinusX: return "-x";
+        case ViewDirection::PlusY: return "+y";
+        case ViewDirection::MinusY: return "-y";
+        case ViewDirection::PlusZ: return "+z";
+        case ViewDirection::MinusZ: return "-z";
+    }
+    return "?";
+}
+
+ViewPoint project(const std::array<double, 3>& p, ViewDirection view) {
+    const double x = p[0], y = p[1], z = p[2];
+    // (right, up, view direction) with right = view x up, so that (right, up, -view) is right-handed.
+    switch (view) {
+        case ViewDirection::PlusY: return {x, z, y};
+        case ViewDirection::MinusY: return {-x, z, -y};
+        case ViewDirection::PlusX: return {-y, z, x};
+        case ViewDirection::MinusX: return {y, z, -x};
+        case ViewDirection::MinusZ: return {x, y, -z};
+        case ViewDirection::PlusZ: return {-x, y, z};
+    }
+    return {x, z, y};
+}
+
+// --- Fields ------------------------------------------------------------------------------------
+
+FieldChoice parse_field_choice(std::string_view text, GeometryKind geometry) {
+    FieldChoice c;
+    const auto colon = text.find(':');
+    c.name = std::string(text.substr(0, colon));
+    if (c.name.empty()) throw InputError(fmt::format("--field '{}': no field name", text));
+    if (colon == std::string_view::npos) {
+        c.label = c.name;
+        return c;
+    }
+    const std::string_view part = text.substr(colon + 1);
+    const bool three_d = geometry == GeometryKind::ThreeD;
+    if (part == "magnitude" || part == "mag") {
+        c.label = "|" + c.name + "|";
+        return c;
+    }
+    if (part == "x") {
+        c.component = 0;
+    } else if (part == "y" && three_d) {
+        c.component = 1;
+    } else if (part == "z") {
+        c.component = three_d ? 2 : 1;  // 2D vectors are stored as (x, z, 0)
+    } else {
+        throw InputError(fmt::format("--field '{}': '{}' is not a component; {} runs have {}, or magnitude", text, part,
+                                     name_of(geometry), three_d ? "x, y, z" : "x and z"));
+    }
+    c.label = c.name + ":" + std::string(part);
+    return c;
+}
+
+std::string_view field_unit(std::string_view name) {
+    static const std::array<std::pair<std::string_view, std::string_view>, 14> units{{
+        {"velocity", "m/s"},
+        {"force", "N"},
+        {"pressure", "Pa"},
+        {"von_mises_stress", "Pa"},
+        {"viscous_pressure", "Pa"},
+        {"temperature", "K"},
+        {"diameter", "m"},
+        {"mass", "kg"},
+        {"density", "kg/m^3"},
+        {"internal_energy", "J/kg"},
+        {"plastic_strain", ""},
+        {"damage", ""},
+        {"volumetric_strain", ""},
+        {"connectivity", ""},
+    }};
+    for (const auto& [n, u] : units) {
+        if (n == name) return u;
+    }
+    return "";
+}
+
+namespace {
+
+// The SI prefix of a value in a unit: exponent and the unit written with it.
+struct DisplayUnit {
+    int exponent = 0;
+    std::string unit;
+};
+
+DisplayUnit display_unit(double magnitude, std::string_view unit) {
+    // The exponents of the prefixes each unit is shown with, largest first; kg takes grams' prefixes.
+    std::string base(unit);
+    int offset = 0;
+    std::vector<int> exponents;
+    if (unit == "Pa" || unit == "J/kg") {
+        exponents = {9, 6, 3, 0};
+    } else if (unit == "m" || unit == "s") {
+        exponents = {0, -3, -6, -9};
+    } else if (unit == "N") {
+        exponents = {9, 6, 3, 0, -3};
+    } else if (unit == "kg") {
+        base = "g";
+        offset = 3;
+        exponents = {3, 0, -3, -6};
+    }
+    if (exponents.empty()) return {0, base};
+    const auto prefix = [](int x) -> std::string {
+        switch (x) {
+            case 9: return "G";
+            case 6: return "M";
+            case 3: return "k";
+            case -3: return "m";
+            case -6: return "u";
+            case -9: return "n";
+            default: return "";
+        }
+    };
+    const double m = std::abs(magnitude) * std::pow(10.0, offset);
+    int e = offset;  // zero (or not finite): the unit as written
+    if (m > 0.0 && std::isfinite(m)) {
+        e = exponents.back();
+        for (int x : exponents) {
+            // 0.9995: a value that rounds to 1000 at three digits takes the next prefix
+            if (m >= 0.9995 * std::pow(10.0, x)) {
+                e = x;
+                break;
+            }
+        }
+    }
+    return {e - offset, prefix(e) + base};
+}
+
+std::string number_text(double v) {
+    if (!std::isfinite(v)) return std::isnan(v) ? "nan" : (v > 0 ? "inf" : "-inf");
+    if (v == 0.0) return "0";
+    return fmt::format("{:.3g}", v);
+}
+
+}  // namespace
+
+std::string format_quantity(double value, std::string_view unit) {
+    const DisplayUnit d = display_unit(value, unit);
+    const std::string number = number_text(value / std::pow(10.0, d.exponent));
+    return d.unit.empty() ? number : number + " " + d.unit;
+}
+
+// --- Snapshots ---------------------------------------------------------------------------------
+
+LoadedSnapshot load_snapshot(const SnapshotIndex& series, std::size_t index) {
+    if (index >= series.snapshots.size()) {
+        throw InputError(fmt::format("{}: no snapshot {}; it lists {} (0 to {})", series.pvd.string(), index,
+                                     series.snapshots.size(), series.snapshots.size() - 1));
+    }
+    LoadedSnapshot s;
+    s.index = index;
+    s.entry = series.snapshots[index];
+    for (const auto& file : s.entry.files) {
+        std::error_code ec;
+        if (!fs::exists(file, ec)) {
+            throw SnapshotError(fmt::format("{}: no such file (listed in {} as snapshot {} at t = {})", file.string(),
+                                            series.pvd.string(), index, format_quantity(s.entry.time, "s")));
+        }
+        s.parts.emplace_back(file);
+    }
+    return s;
+}
+
+std::size_t snapshot_nearest(const SnapshotIndex& series, double t) {
+    std::size_t best = 0;
+    for (std::size_t k = 1; k < series.snapshots.size(); ++k) {
+        if (std::abs(series.snapshots[k].time - t) < std::abs(series.snapshots[best].time - t)) best = k;
+    }
+    return best;
+}
+
+namespace {
+
+// The values of one array reduced to one number per point or cell: the component, or the
+// magnitude of a vector.
+std::vector<double> reduce(const std::vector<double>& values, int components, std::optional<int> component) {
+    const std::size_t n = components > 0 ? values.size() / static_cast<std::size_t>(components) : 0;
+    std::vector<double> out(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        const double* v = values.data() + i * static_cast<std::size_t>(components);
+        if (component) {
+            out[i] = v[*component];
+        } else if (components == 1) {
+            out[i] = v[0];
+        } else {
+            double s = 0.0;
+            for (int c = 0; c < components; ++c) s += v[c] * v[c];
+            out[i] = std::sqrt(s);
+        }
+    }
+    return out;
+}
+
+}  // namespace
+
+std::vector<FieldSummary> list_fields(const LoadedSnapshot& snapshot) {
+    std::vector<FieldSummary> out;
+    for (const auto& part : snapshot.parts) {
+        for (const auto& info : part.arrays()) {
+            const bool particles = part.type() == "PolyData";
+            if (particles && info.location == DataLocation::Cell) continue;
+            const std::string where =
+                particles ? "particles" : info.location == DataLocation::Point ? "element points" : "element cells";
+            auto it = std::find_if(out.begin(), out.end(), [&](const FieldSummary& f) { return f.name == info.name; });
+            if (it == out.end()) {
+                out.push_back({info.name, info.components, where, std::numeric_limits<double>::infinity(),
+                               -std::numeric_limits<double>::infinity(), 0});
+                it = out.end() - 1;
+            } else {
+                it->where += ", " + where;
+            }
+            for (double v : reduce(part.values(info.name, info.location), info.components, std::nullopt)) {
+                if (!std::isfinite(v)) continue;
+                it->min = std::min(it->min, v);
+                it->max = std::max(it->max, v);
+                ++it->values;
+            }
+        }
+    }
+    for (auto& f : out) {
+        if (f.values == 0) f.min = f.max = 0.0;
+    }
+    return out;
+}
+
+// --- Render ------------------------------------------------------------------------------------
+
+namespace {
+
+struct Disc {
+    double u, v, radius, depth;
+    double value;
+    bool has_value;
+};
+
+struct Triangle {
+    std::array<ViewPoint, 3> corner;
+    std::array<double, 3> value;  // the same three times for a cell field
+    bool has_value;
+    double depth;
+};
+
+// The field on one part: its values per point or per cell, or nullopt when the part lacks it.
+struct PartField {
+    DataLocation location;
+    std::vector<double> values;
+};
+
+std::optional<PartField> part_field(const VtkFile& f, const FieldChoice& choice) {
+    const bool particles = f.type() == "PolyData";
+    for (DataLocation l : {DataLocation::Cell, DataLocation::Point}) {
+        if (particles && l == DataLocation::Cell) continue;
+        if (const VtkArrayInfo* info = f.find(choice.name, l)) {
+            if (choice.component && info->components == 1) {
+                throw InputError(fmt::format("--field {}: {} is a scalar field (no components)", choice.label, choice.name));
+            }
+            if (choice.component && *choice.component >= info->components) {
+                throw InputError(fmt::format("--field {}: {} has {} components in {}", choice.label, choice.name,
+                                             info->components, f.path().filename().string()));
+            }
+            return PartField{l, reduce(f.values(choice.name, l), info->components, choice.component)};
+        }
+    }
+    return std::nullopt;
+}
+
+bool finite(const ViewPoint& p) { return std::isfinite(p.u) && std::isfinite(p.v) && std::isfinite(p.depth); }
+
+// A stand-in spacing for files without a diameter field: the side of the cell each point would
+// have if the points filled their bounding box evenly.
+double estimated_spacing(const std::vector<ViewPoint>& points, bool three_d, const std::vector<double>& raw) {
+    std::array<double, 3> lo{}, hi{};
+    lo.fill(std::numeric_limits<double>::infinity());
+    hi.fill(-std::numeric_limits<double>::infinity());
+    std::size_t n = 0;
+    for (std::size_t i = 0; i < points.size(); ++i) {
+        if (!finite(points[i])) continue;
+        for (int c = 0; c < 3; ++c) {
+            lo[c] = std::min(lo[c], raw[3 * i + c]);
+            hi[c] = std::max(hi[c], raw[3 * i + c]);
+        }
+        ++n;
+    }
+    if (n == 0) return 1e-3;
+    const int dims = three_d ? 3 : 2;
+    double largest = 0.0;
+    for (int c = 0; c < dims; ++c) largest = std::max(largest, hi[c] - lo[c]);
+    if (largest <= 0.0) return 1e-3;
+    double measure = 1.0;
+    for (int c = 0; c < dims; ++c) measure *= hi[c] - lo[c] > 0.0 ? hi[c] - lo[c] : largest / std::sqrt(double(n));
+    return std::pow(measure / double(n), 1.0 / dims);
+}
+
+void fill_rect(Image& img, int x0, int y0, int x1, int y1, Rgb c) {
+    for (int y = std::max(y0, 0); y < std::min(y1, img.height); ++y) {
+        for (int x = std::max(x0, 0); x < std::min(x1, img.width); ++x) img.set(x, y, c);
+    }
+}
+
+void draw_text(Image& img, int x, int y, std::string_view text, int scale, Rgb c) {
+    for (std::size_t k = 0; k < text.size(); ++k) {
+        const int gx = x + static_cast<int>(k) * detail::glyph_advance * scale;
+        for (int row = 0; row < detail::glyph_height; ++row) {
+            for (int col = 0; col < detail::glyph_width; ++col) {
+                if (detail::glyph_pixel(text[k], col, row)) {
+                    fill_rect(img, gx + col * scale, y + row * scale, gx + (col + 1) * scale, y + (row + 1) * scale, c);
+                }
+            }
+        }
+    }
+}
+
+// Shortens text to at most `width` pixels (ending in "...").
+std::string fitted(std::string text, int width, int scale) {
+    if (detail::text_width(text, scale) <= width) return text;
+    while (!text.empty() && detail::text_width(text + "...", scale) > width) text.pop_back();
+    return text + "...";
+}
+
+struct Area {
+    int x0, y0, x1, y1;  // [x0, x1) x [y0, y1)
+};
+
+// One value to a colour: the range's ends for values beyond it, the middle of the map for a
+// range of one value.
+Rgb colour_of(double v, bool has_value, double lo, double hi) {
+    if (!has_value) return no_field_colour;
+    if (!std::isfinite(v)) return not_finite_colour;
+    if (!(hi > lo)) return colour_map(0.5);
+    return colour_map((v - lo) / (hi - lo));
+}
+
+void draw_disc(Image& img, const Area& plot, const PictureFrame& frame, const Disc& d, Rgb colour) {
+    const auto [px, py] = frame.pixel(d.u, d.v);
+    const double r = d.radius * frame.scale;
+    const int x0 = std::max(plot.x0, static_cast<int>(std::floor(px - r)));
+    const int x1 = std::min(plot.x1 - 1, static_cast<int>(std::ceil(px + r)));
+    const int y0 = std::max(plot.y0, static_cast<int>(std::floor(py - r)));
+    const int y1 = std::min(plot.y1 - 1, static_cast<int>(std::ceil(py + r)));
+    bool any = false;
+    for (int y = y0; y <= y1; ++y) {
+        for (int x = x0; x <= x1; ++x) {
+            const double dx = x + 0.5 - px, dy = y + 0.5 - py;
+            if (dx * dx + dy * dy <= r * r) {
+                img.set(x, y, colour);
+                any = true;
+            }
+        }
+    }
+    // A disc smaller than a pixel still shows: the pixel holding its centre.
+    const int cx = static_cast<int>(std::floor(px)), cy = static_cast<int>(std::floor(py));
+    if (!any && cx >= plot.x0 && cx < plot.x1 && cy >= plot.y0 && cy < plot.y1) img.set(cx, cy, colour);
+}
+
+void draw_triangle(Image& img, const Area& plot, const PictureFrame& frame, const Triangle& t, double lo, double hi) {
+    std::array<std::array<double, 2>, 3> p;
+    for (int k = 0; k < 3; ++k) p[k] = frame.pixel(t.corner[k].u, t.corner[k].v);
+    const auto edge = [](const std::array<double, 2>& a, const std::array<double, 2>& b, double x, double y) {
+        return (b[0] - a[0]) * (y - a[1]) - (b[1] - a[1]) * (x - a[0]);
+    };
+    const double area = edge(p[0], p[1], p[2][0], p[2][1]);
+    if (area == 0.0 || !std::isfinite(area)) return;
+    const double minx = std::min({p[0][0], p[1][0], p[2][0]}), maxx = std::max({p[0][0], p[1][0], p[2][0]});
+    const double miny = std::min({p[0][1], p[1][1], p[2][1]}), maxy = std::max({p[0][1], p[1][1], p[2][1]});
+    const int x0 = std::max(plot.x0, static_cast<int>(std::floor(minx)));
+    const int x1 = std::min(plot.x1 - 1, static_cast<int>(std::ceil(maxx)));
+    const int y0 = std::max(plot.y0, static_cast<int>(std::floor(miny)));
+    const int y1 = std::min(plot.y1 - 1, static_cast<int>(std::ceil(maxy)));
+    for (int y = y0; y <= y1; ++y) {
+        for (int x = x0; x <= x1; ++x) {
+            const double cx = x + 0.5, cy = y + 0.5;
+            // Barycentric weights from the edge functions; a pixel centre on an edge belongs to both.
+            const double w0 = edge(p[1], p[2], cx, cy) / area;
+            const double w1 = edge(p[2], p[0], cx, cy) / area;
+            const double w2 = edge(p[0], p[1], cx, cy) / area;
+            if (w0 < 0.0 || w1 < 0.0 || w2 < 0.0) continue;
+            const double v = w0 * t.value[0] + w1 * t.value[1] + w2 * t.value[2];
+            img.set(x, y, colour_of(v, t.has_value, lo, hi));
+        }
+    }
+}
+
+// A round length for the scale bar: 1, 2 or 5 times a power of ten, at most `longest`.
+double round_length(double longest) {
+    const double decade = std::pow(10.0, std::floor(std::log10(longest)));
+    for (double f : {5.0, 2.0, 1.0}) {
+        if (f * decade <= longest) return f * decade;
+    }
+    return decade;
+}
+
+}  // namespace
+
+Picture render_snapshot(const LoadedSnapshot& snapshot, GeometryKind geometry, const RenderOptions& options) {
+    const bool three_d = geometry == GeometryKind::ThreeD;
+    if (options.width < min_width || options.width > max_side) {
+        throw InputError(fmt::format("picture width {} px: it must be {} to {}", options.width, min_width, max_side));
+    }
+    if (options.height != 0 && (options.height < min_height || options.height > max_side)) {
+        throw InputError(fmt::format("picture height {} px: it must be {} to {}", options.height, min_height, max_side));
+    }
+    for (const auto& end : {options.range_min, options.range_max}) {
+        if (end && !std::isfinite(*end)) throw InputError(fmt::format("colour range end {} is not a finite number", *end));
+    }
+    if (three_d && options.mirror.value_or(false)) throw InputError("mirroring applies to 2D runs only (this run is 3D)");
+    if (!three_d && options.view) {
+        throw InputError(fmt::format("a view direction applies to 3D runs only (this run is {}: it is drawn in the x-z plane)",
+                                     name_of(geometry)));
+    }
+    const FieldChoice choice = parse_field_choice(options.field, geometry);
+    const ViewDirection view = options.view.value_or(ViewDirection::PlusY);
+    const bool mirror = !three_d && options.mirror.value_or(geometry == GeometryKind::Axisymmetric);
+
+    Picture picture;
+    picture.mirrored = mirror;
+    picture.unit = std::string(field_unit(choice.name));
+    std::vector<Disc> discs;
+    std::vector<Triangle> triangles;
+    bool field_found = false;
+    const auto to_view = [&](const double* p) -> ViewPoint {
+        if (three_d) return project({p[0], p[1], p[2]}, view);
+        return {p[0], p[1], 0.0};  // 2D: stored (x, z, 0)
+    };
+    for (const auto& part : snapshot.parts) {
+        const std::optional<PartField> field = part_field(part, choice);
+        field_found = field_found || field.has_value();
+        const std::vector<double> raw = part.points();
+        std::vector<ViewPoint> points(part.point_count());
+        for (std::size_t i = 0; i < points.size(); ++i) points[i] = to_view(raw.data() + 3 * i);
+        if (part.type() == "PolyData") {
+            std::vector<double> diameter;
+            if (const VtkArrayInfo* d = part.find("diameter", DataLocation::Point); d && d->components == 1) {
+                diameter = part.values("diameter", DataLocation::Point);
+            }
+            const double spacing = diameter.empty() ? estimated_spacing(points, three_d, raw) : 0.0;
+            for (std::size_t i = 0; i < points.size(); ++i) {
+                if (!finite(points[i])) {
+                    ++picture.not_finite_positions;
+                    continue;
+                }
+                const double d = diameter.empty() || !(diameter[i] > 0.0) || !std::isfinite(diameter[i]) ? spacing : diameter[i];
+                const double value = field ? field->values[i] : 0.0;
+                discs.push_back({points[i].u, points[i].v, 0.5 * (d > 0.0 ? d : spacing), points[i].depth, value, field.has_value()});
+                if (!field) ++picture.without_field;
+            }
+        } else {
+            const VtkCells cells = part.cells();
+            for (std::size_t c = 0; c < cells.types.size(); ++c) {
+                const std::size_t begin = c == 0 ? 0 : static_cast<std::size_t>(cells.offsets[c - 1]);
+                const std::size_t end = static_cast<std::size_t>(cells.offsets[c]);
+                const std::uint8_t type = cells.types[c];
+                if ((type != 5 && type != 7 && type != 9) || end - begin < 3) continue;  // triangle, polygon, quad
+                if (!field) ++picture.without_field;
+                // A fan from the first corner (a quadrilateral or convex polygon).
+                for (std::size_t k = begin + 1; k + 1 < end; ++k) {
+                    const std::array<std::size_t, 3> ids{static_cast<std::size_t>(cells.connectivity[begin]),
+                                                         static_cast<std::size_t>(cells.connectivity[k]),
+                                                         static_cast<std::size_t>(cells.connectivity[k + 1])};
+                    Triangle t{};
+                    bool ok = true;
+                    for (int j = 0; j < 3; ++j) {
+                        t.corner[j] = points[ids[j]];
+                        ok = ok && finite(t.corner[j]);
+                        t.value[j] = !field ? 0.0 : field->location == DataLocation::Cell ? field->values[c] : field->values[ids[j]];
+                    }
+                    if (!ok) {
+                        ++picture.not_finite_positions;
+                        continue;
+                    }
+                    t.has_value = field.has_value();
+                    t.depth = (t.corner[0].depth + t.corner[1].depth + t.corner[2].depth) / 3.0;
+                    triangles.push_back(t);
+                }
+            }
+        }
+    }
+    if (!field_found) {
+        std::vector<std::string> names;
+        for (const auto& f : list_fields(snapshot)) names.push_back(f.name);
+        std::sort(names.begin(), names.end());
+        std::string files;
+        for (const auto& f : snapshot.entry.files) files += (files.empty() ? "" : ", ") + f.filename().string();
+        throw InputError(fmt::format("no field '{}' in snapshot {} ({}); the fields are: {}", choice.name, snapshot.index, files,
+                                     fmt::join(names, ", ")));
+    }
+    if (discs.empty() && triangles.empty()) {
+        throw InputError(fmt::format("snapshot {} ({}) has nothing to draw: no nodes or cells with finite positions",
+                                     snapshot.index, snapshot.entry.files.front().string()));
+    }
+    if (mirror) {
+        const std::size_t n = discs.size();
+        for (std::size_t i = 0; i < n; ++i) {
+            Disc d = discs[i];
+            d.u = -d.u;
+            discs.push_back(d);
+        }
+        const std::size_t m = triangles.size();
+        for (std::size_t i = 0; i < m; ++i) {
+            Triangle t = triangles[i];
+            for (auto& c : t.corner) c.u = -c.u;
+            triangles.push_back(t);
+        }
+    }
+    picture.discs = mirror ? discs.size() / 2 : discs.size();
+    picture.triangles = mirror ? triangles.size() / 2 : triangles.size();
+    if (three_d) {
+        // Painter's order: the farthest first, the file's order among equals.
+        const auto farther = [](const auto& a, const auto& b) { return a.depth > b.depth; };
+        std::stable_sort(discs.begin(), discs.end(), farther);
+        std::stable_sort(triangles.begin(), triangles.end(), farther);
+    }
+
+    // The colour range: the option's, or that of the finite values drawn.
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    const auto count_value = [&](double v, bool has) {
+        if (!has) return;
+        if (!std::isfinite(v)) {
+            ++picture.not_finite_values;
+            return;
+        }
+        lo = std::min(lo, v);
+        hi = std::max(hi, v);
+    };
+    // Over the nodes and cells once: mirrored images are the second half of each list (3D runs,
+    // which are sorted, are never mirrored).
+    const std::size_t own_discs = picture.discs, own_triangles = picture.triangles;
+    for (std::size_t i = 0; i < own_discs; ++i) count_value(discs[i].value, discs[i].has_value);
+    for (std::size_t i = 0; i < own_triangles; ++i) {
+        for (double v : triangles[i].value) count_value(v, triangles[i].has_value);
+    }
+    if (!(lo <= hi)) lo = hi = 0.0;  // nothing finite
+    if (options.range_min || options.range_max) {
+        const double rlo = options.range_min.value_or(lo), rhi = options.range_max.value_or(hi);
+        if (!(rlo < rhi)) {
+            const std::string unit(field_unit(choice.name));
+            throw InputError(fmt::format("colour range {} to {} ({}): it must end above where it starts (the field's own range "
+                                         "is {} to {})",
+                                         format_quantity(rlo, unit), format_quantity(rhi, unit), choice.label,
+                                         format_quantity(lo, unit), format_quantity(hi, unit)));
+        }
+        for (std::size_t i = 0; i < own_discs; ++i) {
+            if (!discs[i].has_value || !std::isfinite(discs[i].value)) continue;
+            picture.below_range += discs[i].value < rlo;
+            picture.above_range += discs[i].value > rhi;
+        }
+        for (std::size_t i = 0; i < own_triangles; ++i) {
+            if (!triangles[i].has_value) continue;
+            const auto [low, high] = std::minmax({triangles[i].value[0], triangles[i].value[1], triangles[i].value[2]});
+            picture.below_range += low < rlo;
+            picture.above_range += high > rhi;
+        }
+        lo = rlo;
+        hi = rhi;
+    }
+    picture.range_min = lo;
+    picture.range_max = hi;
+
+    // Layout: text at the top, the colour bar on the right, the length scale at the bottom.
+    const DisplayUnit shown = display_unit(std::max(std::abs(lo), std::abs(hi)), picture.unit);
+    const double divisor = std::pow(10.0, shown.exponent);
+    const bool uniform = !(hi > lo);
+    const std::array<double, 5> tick_fractions{1.0, 0.75, 0.5, 0.25, 0.0};
+    std::vector<std::string> tick_labels;
+    if (uniform) {
+        tick_labels.push_back(number_text(lo / divisor) + " (uniform)");
+    } else {
+        for (double f : tick_fractions) tick_labels.push_back(number_text((lo + f * (hi - lo)) / divisor));
+    }
+    const int width = options.width;
+    // The text's scale: one font pixel per 450 picture pixels of the shorter side given, 1 to 4.
+    const int s = std::clamp(static_cast<int>(std::lround(std::min(width, options.height > 0 ? options.height : width) / 450.0)),
+                             1, 4);
+    const int margin = 8 * s, text_h = detail::text_height(s), line = detail::line_height * s;
+    int label_w = 0;
+    for (const auto& l : tick_labels) label_w = std::max(label_w, detail::text_width(l, s));
+    const int bar_w = 16 * s, tick_len = 4 * s;
+    const int right = margin + bar_w + tick_len + 2 * s + label_w + margin;
+    const int top = margin + 2 * line + margin / 2;
+    const int bottom = margin + 2 * s + 4 * s + line + line + margin / 2;
+
+    double umin = std::numeric_limits<double>::infinity(), umax = -umin, vmin = umin, vmax = -umin;
+    const auto extend = [&](double u, double v, double r) {
+        umin = std::min(umin, u - r);
+        umax = std::max(umax, u + r);
+        vmin = std::min(vmin, v - r);
+        vmax = std::max(vmax, v + r);
+    };
+    for (const auto& d : discs) extend(d.u, d.v, d.radius);
+    for (const auto& t : triangles) {
+        for (const auto& c : t.corner) extend(c.u, c.v, 0.0);
+    }
+    double world_w = umax - umin, world_h = vmax - vmin;
+    const double world_size = std::max(world_w, world_h) > 0.0 ? std::max(world_w, world_h) : 1e-3;
+    world_w = std::max(world_w, 1e-3 * world_size);
+    world_h = std::max(world_h, 1e-3 * world_size);
+    const int plot_w = width - margin - right;
+    int height = options.height;
+    if (height == 0) {
+        const double wanted = top + bottom + plot_w * world_h / world_w;
+        height = static_cast<int>(std::clamp(std::ceil(wanted), double(min_height), double(std::min(max_side, 2 * width))));
+    }
+    const Area plot{margin, top, width - right, height - bottom};
+    if (plot.x1 - plot.x0 < 16 || plot.y1 - plot.y0 < 16) {
+        throw InputError(fmt::format("picture {}x{} px leaves no room for the drawing beside the colour bar and text; make it larger",
+                                     width, height));
+    }
+    const double plot_wd = plot.x1 - plot.x0, plot_hd = plot.y1 - plot.y0;
+    PictureFrame frame;
+    frame.scale = 0.98 * std::min(plot_wd / world_w, plot_hd / world_h);
+    frame.u_left = 0.5 * (umin + umax) - 0.5 * plot_wd / frame.scale;
+    frame.v_top = 0.5 * (vmin + vmax) + 0.5 * plot_hd / frame.scale;
+    frame.left = plot.x0;
+    frame.top = plot.y0;
+    picture.frame = frame;
+
+    Image img(width, height, background_colour);
+    for (const auto& t : triangles) draw_triangle(img, plot, frame, t, lo, hi);
+    for (const auto& d : discs) draw_disc(img, plot, frame, d, colour_of(d.value, d.has_value, lo, hi));
+
+    // Text at the top: the title and mark, then the field, its unit and the time.
+    std::string first = options.title;
+    if (!snapshot.entry.mark.empty()) first += (first.empty() ? "" : "  ") + std::string("[") + snapshot.entry.mark + "]";
+    if (first.empty()) first = snapshot.entry.files.front().filename().string();
+    std::string second = choice.label;
+    if (!shown.unit.empty()) second += " (" + shown.unit + ")";
+    second += "   t = " + format_quantity(snapshot.entry.time, "s");
+    if (three_d) second += "   view " + std::string(name_of(view));
+    const int text_room = width - 2 * margin;
+    draw_text(img, margin, margin, fitted(first, text_room, s), s, text_colour);
+    draw_text(img, margin, margin + line, fitted(second, text_room, s), s, text_colour);
+
+    // The colour bar, its frame, ticks and labels.
+    const int bar_x = width - right + margin;
+    const int bar_top = plot.y0 + text_h / 2;
+    const int bar_h = std::max(40 * s, static_cast<int>(0.6 * (plot.y1 - plot.y0)));
+    const int bar_bottom = std::min(plot.y1 - text_h / 2, bar_top + bar_h);
+    const int rows = bar_bottom - bar_top;
+    for (int y = bar_top; y < bar_bottom; ++y) {
+        const double f = uniform ? 0.5 : 1.0 - (y - bar_top + 0.5) / rows;
+        fill_rect(img, bar_x, y, bar_x + bar_w, y + 1, colour_map(f));
+    }
+    fill_rect(img, bar_x - 1, bar_top - 1, bar_x + bar_w + 1, bar_top, text_colour);
+    fill_rect(img, bar_x - 1, bar_bottom, bar_x + bar_w + 1, bar_bottom + 1, text_colour);
+    fill_rect(img, bar_x - 1, bar_top - 1, bar_x, bar_bottom + 1, text_colour);
+    fill_rect(img, bar_x + bar_w, bar_top - 1, bar_x + bar_w + 1, bar_bottom + 1, text_colour);
+    for (std::size_t k = 0; k < tick_labels.size(); ++k) {
+        const double f = uniform ? 0.5 : tick_fractions[k];
+        const int y = bar_top + static_cast<int>(std::lround((1.0 - f) * rows));
+        fill_rect(img, bar_x + bar_w, y - s / 2, bar_x + bar_w + tick_len, y - s / 2 + s, text_colour);
+        draw_text(img, bar_x + bar_w + tick_len + 2 * s, y - text_h / 2 + s, tick_labels[k], s, text_colour);
+    }
+
+    // The length scale under the drawing, and a note on what is not coloured by the field.
+    const double visible = plot_wd / frame.scale;
+    const double length = round_length(0.25 * visible);
+    const int length_px = static_cast<int>(std::lround(length * frame.scale));
+    const int scale_y = plot.y1 + margin / 2 + 4 * s;
+    fill_rect(img, plot.x0, scale_y, plot.x0 + length_px, scale_y + 2 * s, text_colour);
+    fill_rect(img, plot.x0, scale_y - 2 * s, plot.x0 + s, scale_y + 4 * s, text_colour);
+    fill_rect(img, plot.x0 + length_px - s, scale_y - 2 * s, plot.x0 + length_px, scale_y + 4 * s, text_colour);
+    draw_text(img, plot.x0, scale_y + 6 * s, format_quantity(length, "m"), s, text_colour);
+    std::vector<std::string> notes;
+    if (picture.not_finite_values > 0) notes.push_back(fmt::format("magenta: {} not finite", picture.not_finite_values));
+    if (picture.without_field > 0) notes.push_back(fmt::format("grey: {} without {}", picture.without_field, choice.name));
+    if (picture.not_finite_positions > 0) notes.push_back(fmt::format("{} left out (position not finite)", picture.not_finite_positions));
+    if (picture.below_range + picture.above_range > 0) {
+        notes.push_back(fmt::format("{} below, {} above the range", picture.below_range, picture.above_range));
+    }
+    if (!notes.empty()) {
+        std::string text;
+        for (const auto& n : notes) text += (text.empty() ? "" : "; ") + n;
+        const int x = plot.x0 + std::max(length_px, detail::text_width(format_quantity(length, "m"), s)) + 3 * margin;
+        draw_text(img, x, scale_y + 6 * s, fitted(text, width - x - margin, s), s, text_colour);
+    }
+    picture.image = std::move(img);
+    return picture;
+}
+
+// --- PNG ---------------------------------------------------------------------------------------
+
+std::string encode_png(const Image& image) {
+    if (image.width <= 0 || image.height <= 0 ||
+        image.rgb.size() != static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height) * 3) {
+        throw std::invalid_argument(fmt::format("encode_png: an image of {}x{} pixels with {} bytes", image.width, image.height,
+                                                image.rgb.size()));
+    }
+    png_image png;
+    std::memset(&png, 0, sizeof png);
+    png.version = PNG_IMAGE_VERSION;
+    png.width = static_cast<png_uint_32>(image.width);
+    png.height = static_cast<png_uint_32>(image.height);
+    png.format = PNG_FORMAT_RGB;
+    png_alloc_size_t size = 0;
+    const auto row_stride = static_cast<png_int_32>(image.width * 3);
+    if (!png_image_write_to_memory(&png, nullptr, &size, 0, image.rgb.data(), row_stride, nullptr)) {
+        const std::string why = png.message;
+        png_image_free(&png);
+        throw std::runtime_error("libpng: " + why);
+    }
+    std::string out(size, '\0');
+    if (!png_image_write_to_memory(&png, out.data(), &size, 0, image.rgb.data(), row_stride, nullptr)) {
+        const std::string why = png.message;
+        png_image_free(&png);
+        throw std::runtime_error("libpng: " + why);
+    }
+    out.resize(size);
+    return out;
+}
+
+void write_png(const fs::path& file, const Image& image) {
+    const std::string bytes = encode_png(image);
+    write_file_atomically(file, [&](std::ofstream& out) { out.write(bytes.data(), static_cast<std::streamsize>(bytes.size())); });
+}
+
+}  // namespace gpa::io
