@@ -230,6 +230,14 @@ void print_report(const Simulation& sim) {
     }
     fmt::print("  plastic work {:.4g} J, viscous work {:.4g} J, boundary work {:.3g} J, energy error {:+.3g} %\n",
                t.plastic_work, t.viscous_work, t.boundary_work, 100.0 * t.energy_error);
+    const int dim = sim.nodes().dim();
+    for (const auto& r : t.regions) {
+        std::string reaction;
+        for (int c = 0; c < dim; ++c) {
+            if (r.held[c]) reaction += fmt::format(", reaction {} {:.4g} N", "xyz"[dim == 2 && c == 1 ? 2 : c], r.reaction[c]);
+        }
+        fmt::print("  prescribed velocity \"{}\": work {:.4g} J{}\n", r.name, r.work, reaction);
+    }
     for (const auto& c : io::compare_with_reference(sim)) {
         fmt::print("  {}: {:.4g} against the reference {:.4g} ({:+.2f} %)\n", c.key, c.computed, c.reference,
                    100.0 * c.relative_error);
@@ -560,6 +568,16 @@ int check_scene(const fs::path& file, const MemoryLimit& memory) {
         }
         fmt::print("  body \"{}\": {}, {} nodes{}, lattice spacing {:.4g} x {:.4g} mm\n", scene.bodies[b].name,
                    scene.bodies[b].material, count, elements, block.spacing[0] * 1e3, block.spacing[1] * 1e3);
+    }
+    for (std::size_t k = 0; k < scene.prescribed_velocities.size(); ++k) {
+        const auto& r = scene.prescribed_velocities[k];
+        std::string held;
+        const int dim = dimension_of(scene.geometry);
+        for (int c = 0; c < dim; ++c) {
+            if (r.velocity[c]) held += fmt::format("{}{} = {:g} m/s", held.empty() ? "" : ", ", "xyz"[dim == 2 && c == 1 ? 2 : c], *r.velocity[c]);
+        }
+        fmt::print("  prescribed velocity \"{}\": {} nodes of body \"{}\" at {}{}\n", r.name, sim.totals().regions[k].nodes, r.body, held,
+                   r.ramp > 0.0 ? fmt::format(" after a {:.4g} us ramp", r.ramp * 1e6) : std::string());
     }
     fmt::print("  first time step {:.3g} ns; phases: {}\n", sim.next_time_step() * 1e9, fmt::join(sim.phases(), ", "));
     return 0;

@@ -35,6 +35,14 @@ std::string totals_bytes(const Totals& t) {
         add(p.reaction);
         add(p.impulse);
     }
+    add(t.energy_given);
+    for (const auto& r : t.regions) {
+        add(r.nodes);
+        add(r.work);
+        for (int c = 0; c < 3; ++c) {
+            for (const double v : {r.velocity[c], r.displacement[c], r.reaction[c], r.impulse[c]}) add(v);
+        }
+    }
     return out;
 }
 
@@ -104,6 +112,16 @@ std::vector<Case> cases() {
         scene.solver.connectivity = ConnectivityMode::Automatic;
         scene.solver.switch_plastic_strain = 0.05;
         out.push_back({"3D quarter bar on symmetry planes, automatic", scene, 47, 70});
+    }
+    {
+        // Prescribed velocities: the work booked up to the last step and that step's own, the
+        // impulses and displacements, the held nodes renumbered by reorderings.
+        auto scene = testing::pulled_elastic_bar(GeometryKind::Axisymmetric, 1e-3, 10e-3, 10, 5.0, 0.2e-6, 0.3);
+        scene.solver.smoothing = SmoothingMode::Tension;
+        scene.solver.reorder_interval = 20;
+        scene.stop = {};
+        scene.stop.max_steps = 100000;
+        out.push_back({"pulled bar with a grip and a clamp, smoothing in tension", scene, 37, 80, true});
     }
     {
         auto scene = testing::armco_cylinder(10, 40e-6);

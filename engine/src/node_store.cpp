@@ -57,6 +57,7 @@ void NodeStore::for_each_field(F&& f) {
     f(viscous_work);
     f(failed);
     f(plane_contact);
+    f(velocity_region);
     f(stable_length);
     f(body);
     f(material);

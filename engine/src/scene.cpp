@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdint>
 #include <exception>
 #include <string>
 #include <string_view>
@@ -10,7 +11,9 @@
 
 #include <fmt/format.h>
 
+#include "gpa/engine/bodies.hpp"
 #include "gpa/engine/errors.hpp"
+#include "gpa/engine/prescribed.hpp"
 
 // The rules a scene must keep, for a scene read from a file and one built in code alike.
 // Messages use the scene file's key names (solver.cfl, body "bar" (body[0]).radius), which are
@@ -327,6 +330,172 @@ void check_output(const OutputOptions& o) {
     }
 }
 
+std::string region_label(const PrescribedVelocitySpec& r, std::size_t i) {
+    return r.name.empty() ? fmt::format("prescribed_velocity[{}]", i)
+                          : fmt::format("prescribed_velocity \"{}\" (prescribed_velocity[{}])", r.name, i);
+}
+
+// Calls visit(p) for the initial node positions of body b (particles: lattice cell centres;
+// elements: cell centres and corners, corners once per cell) in the cells that can reach the box
+// [lo, hi], until visit returns true; returns whether it did.
+template <class F>
+bool any_initial_node(const Scene& scene, std::size_t b, const std::array<double, 3>& lo, const std::array<double, 3>& hi,
+                      F&& visit) {
+    const LatticeBlock block = body_lattice(scene, b);
+    const int dim = dimension_of(scene.geometry);
+    const bool elements = scene.bodies[b].discretisation == Discretisation::Elements;
+    std::array<std::int64_t, 3> from = block.first, to = block.last;
+    for (int c = 0; c < dim; ++c) {
+        const double o = block.origin[c], s = block.spacing[c];
+        const double first = double(block.first[c]) - 1.0, last = double(block.last[c]) + 1.0;
+        if (std::isfinite(lo[c])) from[c] = std::max(from[c], std::int64_t(std::clamp(std::floor((lo[c] - o) / s) - 1.0, first, last)));
+        if (std::isfinite(hi[c])) to[c] = std::min(to[c], std::int64_t(std::clamp(std::ceil((hi[c] - o) / s) + 1.0, first, last)));
+    }
+    if (dim == 2) {
+        from[2] = 0;
+        to[2] = 1;
+    }
+    for (std::int64_t kz = from[2]; kz < to[2]; ++kz) {
+        for (std::int64_t ky = from[1]; ky < to[1]; ++ky) {
+            for (std::int64_t kx = from[0]; kx < to[0]; ++kx) {
+                const std::array<std::int64_t, 3> k{kx, ky, kz};
+                std::array<double, 3> centre{0, 0, 0};
+                for (int c = 0; c < dim; ++c) centre[c] = block.origin[c] + (double(k[c]) + 0.5) * block.spacing[c];
+                if (block.inside && !block.inside(centre)) continue;
+                if (visit(centre)) return true;
+                if (!elements) continue;
+                for (int corner = 0; corner < 4; ++corner) {  // element bodies are 2D
+                    const std::array<double, 3> p{block.origin[0] + double(kx + (corner & 1)) * block.spacing[0],
+                                                  block.origin[1] + double(ky + (corner >> 1)) * block.spacing[1], 0.0};
+                    if (visit(p)) return true;
+                }
+            }
+        }
+    }
+    return false;
+}
+
+// The largest distance of a body's points from its axis (prescribed.hpp, body_axis).
+double largest_radius(const BodySpec& b, GeometryKind g) {
+    if (is_round(b.shape)) return b.radius;
+    if (g == GeometryKind::Axisymmetric) return b.origin[0] + b.size[0];
+    if (g == GeometryKind::PlaneStrain) return 0.5 * b.size[0];
+    return 0.5 * std::hypot(b.size[0], b.size[1]);
+}
+
+void check_prescribed_velocity(const Scene& scene, std::size_t k) {
+    const PrescribedVelocitySpec& r = scene.prescribed_velocities[k];
+    const GeometryKind g = scene.geometry;
+    const int dim = dimension_of(g);
+    const std::string label = region_label(r, k);
+    const auto fail_here = [&](const std::string& message) { throw PrescribedVelocityError(message, k); };
+
+    for (std::size_t j = 0; j < k; ++j) {
+        if (!r.name.empty() && scene.prescribed_velocities[j].name == r.name) {
+            fail_here(fmt::format("{}: the name is already used by prescribed_velocity[{}]", label, j));
+        }
+    }
+    const auto body = std::find_if(scene.bodies.begin(), scene.bodies.end(), [&](const BodySpec& b) { return b.name == r.body; });
+    if (body == scene.bodies.end()) {
+        std::string names;
+        for (const auto& b : scene.bodies) names += (names.empty() ? "" : ", ") + fmt::format("\"{}\"", b.name);
+        fail_here(fmt::format("{}.body: \"{}\" is not a body of the scene (its bodies: {})", label, r.body, names));
+    }
+    const std::size_t b = static_cast<std::size_t>(body - scene.bodies.begin());
+
+    // The motion.
+    std::string components;
+    for (int c = 0; c < dim; ++c) components += fmt::format("{}{}", c ? ", " : "", axis_letter(c, dim));
+    if (held_components(r) == 0) {
+        fail_here(fmt::format("{}.velocity prescribes no component: give at least one of {} (the others stay free)", label,
+                              components));
+    }
+    for (int c = 0; c < 3; ++c) {
+        if (!r.velocity[c]) continue;
+        if (c >= dim) fail_here(fmt::format("{}.velocity: a 2D scene has no y component (its components are {})", label, components));
+        if (!finite(*r.velocity[c])) fail_here(fmt::format("{}.velocity.{} must be finite", label, axis_letter(c, dim)));
+    }
+    if (!(r.ramp >= 0.0 && finite(r.ramp))) {
+        fail_here(fmt::format("{}.ramp = {} must be a finite time >= 0 (s; 0 = the full velocity from t = 0)", label, r.ramp));
+    }
+
+    // The region.
+    for (int c = 0; c < 3; ++c) {
+        if (std::isnan(r.lower[c]) || std::isnan(r.upper[c])) fail_here(fmt::format("{}.region: a bound is not a number", label));
+        if (c >= dim) {
+            if (r.lower[c] != -INFINITY || r.upper[c] != INFINITY) fail_here(fmt::format("{}.region: a 2D scene has no y bounds", label));
+            continue;
+        }
+        if (r.lower[c] > r.upper[c]) {
+            fail_here(fmt::format("{}.region: its lower bound {} = {} m lies above its upper bound {} m", label,
+                                  axis_letter(c, dim), r.lower[c], r.upper[c]));
+        }
+    }
+    if (!(r.radius_min >= 0.0 && finite(r.radius_min)) || std::isnan(r.radius_max) || r.radius_max < r.radius_min) {
+        fail_here(fmt::format("{}.region: the radii [{}, {}] m are not a range from a finite radius >= 0 up", label,
+                              r.radius_min, r.radius_max));
+    }
+    const BodySpec& spec = *body;
+    std::string spans;
+    bool outside = r.radius_min > largest_radius(spec, g) * (1.0 + 1e-12);
+    for (int c = 0; c < dim; ++c) {
+        const auto [lo, hi] = extent(spec, g, c);
+        spans += fmt::format("{}{} from {:.6g} to {:.6g} mm", c ? ", " : "", axis_letter(c, dim), lo * 1e3, hi * 1e3);
+        const double tolerance = 1e-9 * std::max(spec.spacing, std::max(std::abs(lo), std::abs(hi)));
+        outside = outside || r.upper[c] < lo - tolerance || r.lower[c] > hi + tolerance;
+    }
+    if (outside) {
+        fail_here(fmt::format("{}.region lies outside body \"{}\" (it spans {}; radii up to {:.6g} mm from its axis)", label,
+                              spec.name, spans, largest_radius(spec, g) * 1e3));
+    }
+    const auto axis = body_axis(scene, b);
+    const auto inside = [&](const PrescribedVelocitySpec& region, const std::array<double, 3>& p) {
+        return in_region(region, g, axis, p);
+    };
+    if (!any_initial_node(scene, b, r.lower, r.upper, [&](const auto& p) { return inside(r, p); })) {
+        const LatticeBlock block = body_lattice(scene, b);
+        fail_here(fmt::format("{}.region holds no node of body \"{}\": it lies between the rows of its lattice (spacing {:.4g} "
+                              "mm); make it at least one spacing wide",
+                              label, spec.name, block.spacing[0] * 1e3));
+    }
+    for (std::size_t j = 0; j < k; ++j) {
+        const PrescribedVelocitySpec& other = scene.prescribed_velocities[j];
+        if (other.body != r.body) continue;
+        std::array<double, 3> lo, hi;
+        for (int c = 0; c < 3; ++c) {
+            lo[c] = std::max(r.lower[c], other.lower[c]);
+            hi[c] = std::min(r.upper[c], other.upper[c]);
+        }
+        if (any_initial_node(scene, b, lo, hi, [&](const auto& p) { return inside(r, p) && inside(other, p); })) {
+            fail_here(fmt::format("{}.region shares nodes of body \"{}\" with {}: a node follows one prescribed velocity; "
+                                  "make the regions disjoint",
+                                  label, spec.name, region_label(other, j)));
+        }
+    }
+    // A plane (or the axis) that the region's nodes touch and that the region would move them
+    // along the normal of: through a rigid wall, off a symmetry plane.
+    const LatticeBlock block = body_lattice(scene, b);
+    const double d0 = dim == 3 ? block.spacing[0] : std::sqrt(block.spacing[0] * block.spacing[1]);
+    const auto moves_along = [&](int a) { return r.velocity[a] && *r.velocity[a] != 0.0; };
+    const auto touches = [&](int a, double position) {
+        return any_initial_node(scene, b, r.lower, r.upper,
+                                [&](const auto& p) { return inside(r, p) && std::abs(p[a] - position) < 0.75 * d0; });
+    };
+    if (g == GeometryKind::Axisymmetric && moves_along(0) && touches(0, 0.0)) {
+        fail_here(fmt::format("{} moves nodes at the axis radially (velocity.x = {} m/s): nodes next to the axis cannot move "
+                              "off it; hold x at 0 there or start the region at a radius of one spacing or more",
+                              label, *r.velocity[0]));
+    }
+    for (std::size_t p = 0; p < scene.planes.size(); ++p) {
+        const PlaneSpec& plane = scene.planes[p];
+        if (!moves_along(plane.axis) || !touches(plane.axis, plane.position)) continue;
+        fail_here(fmt::format("{} moves nodes that touch {} along its normal (velocity.{} = {} m/s): they would be driven "
+                              "{} it; hold {} at 0 there (a clamp on the plane) or keep the region off the plane",
+                              label, plane_label(plane, p), axis_letter(plane.axis, dim), *r.velocity[plane.axis],
+                              plane.kind == PlaneKind::Rigid ? "into or off" : "off", axis_letter(plane.axis, dim)));
+    }
+}
+
 }  // namespace
 
 std::string_view name_of(ShapeKind s) {
@@ -399,6 +568,11 @@ void validate_scene(const Scene& scene) {
             }
         }
     }
+
+    if (scene.prescribed_velocities.size() > 255) {
+        fail(fmt::format("prescribed_velocity: {} regions, at most 255", scene.prescribed_velocities.size()));
+    }
+    for (std::size_t k = 0; k < scene.prescribed_velocities.size(); ++k) check_prescribed_velocity(scene, k);
 
     check_solver(scene.solver);
     check_stop(scene.stop);

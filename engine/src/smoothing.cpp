@@ -61,8 +61,10 @@ double smooth_impl(const CompressedRows& lists, const ScatterPlan& plan, const P
         [&](const tbb::blocked_range<std::size_t>& r, double moved) {
             for (std::size_t i = r.begin(); i != r.end(); ++i) {
                 double before = 0.0, after = 0.0;
+                const unsigned held = options.held ? options.held[i] : 0u;
                 for (int c = 0; c < D; ++c) {
-                    const double old_v = v[c][i], new_v = old_v + scratch.total_change[D * i + c];
+                    const double old_v = v[c][i];
+                    const double new_v = (held >> c) & 1u ? old_v : old_v + scratch.total_change[D * i + c];
                     before += old_v * old_v;
                     after += new_v * new_v;
                     v[c][i] = new_v;

@@ -68,6 +68,8 @@ void RunFolder::commit() {
 
 namespace {
 
+char component_letter(int dim, int c) { return dim == 2 ? (c == 0 ? 'x' : 'z') : "xyz"[c]; }
+
 // Per-body columns, for scenes of more than one body (body_report.hpp defines them).
 std::string body_columns(const Totals& t, int dim) {
     if (t.bodies.size() < 2) return {};
@@ -105,6 +107,16 @@ std::string history_header(const Totals& first, int dim) {
     header += dim == 3 ? ",momentum_x_kg_m_s,momentum_y_kg_m_s,momentum_z_kg_m_s" : ",momentum_x_kg_m_s,momentum_z_kg_m_s";
     header += ",length_m,footprint_diameter_m";
     for (const auto& p : first.planes) header += fmt::format(",{0}_reaction_N,{0}_impulse_N_s", p.name.empty() ? "plane" : p.name);
+    for (const auto& r : first.regions) {
+        const std::string name = r.name.empty() ? "region" : r.name;
+        for (const char* quantity : {"reaction", "impulse", "displacement"}) {
+            const char* unit = quantity[0] == 'r' ? "N" : quantity[0] == 'i' ? "N_s" : "m";
+            for (int c = 0; c < dim; ++c) {
+                if (r.held[c]) header += fmt::format(",{}_{}_{}_{}", name, quantity, component_letter(dim, c), unit);
+            }
+        }
+        header += fmt::format(",{}_work_J", name);
+    }
     header += ",real_nodes,ghost_nodes,variable_nodes,failed_nodes,neighbour_pairs,element_nodes,elements";
     header += body_columns(first, dim);
     return header + "\n";
@@ -114,6 +126,7 @@ std::string history_header(const Totals& first, int dim) {
 
 HistoryWriter::HistoryWriter(const fs::path& file, const Totals& first, int dim)
     : path_(file), dim_(dim), planes_(first.planes.size()) {
+    for (const auto& r : first.regions) regions_.push_back(r.held);
     fd_ = ::open(file.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
     if (fd_ < 0) throw OutputError(fmt::format("cannot write '{}': {}", file.string(), std::strerror(errno)));
     append(history_header(first, dim));
@@ -121,6 +134,7 @@ HistoryWriter::HistoryWriter(const fs::path& file, const Totals& first, int dim)
 
 HistoryWriter::HistoryWriter(const fs::path& file, const Totals& first, int dim, const std::function<bool(std::size_t)>& keep)
     : path_(file), dim_(dim), planes_(first.planes.size()) {
+    for (const auto& r : first.regions) regions_.push_back(r.held);
     std::ifstream in(file, std::ios::binary);
     if (!in) throw OutputError(fmt::format("cannot read '{}' of the stopped run", file.string()));
     const std::string header = history_header(first, dim);
@@ -173,6 +187,15 @@ void HistoryWriter::write(const Totals& t) {
     for (std::size_t p = 0; p < planes_; ++p) {
         const PlaneReport r = p < t.planes.size() ? t.planes[p] : PlaneReport{};
         row += fmt::format(",{:.9e},{:.9e}", r.reaction, r.impulse);
+    }
+    for (std::size_t k = 0; k < regions_.size(); ++k) {
+        const RegionReport r = k < t.regions.size() ? t.regions[k] : RegionReport{};
+        for (const auto& values : {r.reaction, r.impulse, r.displacement}) {
+            for (int c = 0; c < dim_; ++c) {
+                if (regions_[k][c]) row += fmt::format(",{:.9e}", values[c]);
+            }
+        }
+        row += fmt::format(",{:.9e}", r.work);
     }
     row += fmt::format(",{},{},{},{},{},{},{}", t.real_nodes, t.ghost_nodes, t.variable_nodes, t.failed_nodes, t.pairs,
                        t.element_nodes, t.elements);
@@ -304,10 +327,10 @@ void write_summary(const fs::path& file, const Simulation& sim, const RunSummary
     field("final", fmt::format("{{\"length_m\": {}, \"footprint_diameter_m\": {}, \"plastic_work_J\": {}}}",
                                json_number(t.length), json_number(t.footprint_diameter), json_number(t.plastic_work)));
     field("energy", fmt::format("{{\"initial_J\": {}, \"kinetic_J\": {}, \"internal_J\": {}, \"plastic_work_J\": {}, "
-                                "\"viscous_work_J\": {}, \"hourglass_work_J\": {}, \"boundary_work_J\": {}, \"relative_error\": {}}}",
+                                "\"viscous_work_J\": {}, \"hourglass_work_J\": {}, \"boundary_work_J\": {}, \"given_J\": {}, \"relative_error\": {}}}",
                                 json_number(t.initial_energy), json_number(t.kinetic_energy), json_number(t.internal_energy),
                                 json_number(t.plastic_work), json_number(t.viscous_work), json_number(t.hourglass_work),
-                                json_number(t.boundary_work),
+                                json_number(t.boundary_work), json_number(t.energy_given),
                                 json_number(t.energy_error)));
     std::string planes = "[";
     for (std::size_t p = 0; p < t.planes.size(); ++p) {
@@ -315,8 +338,24 @@ void write_summary(const fs::path& file, const Simulation& sim, const RunSummary
                               json_string(t.planes[p].name), json_number(t.planes[p].reaction), json_number(t.planes[p].impulse));
     }
     field("planes", planes + "]");
+    std::string regions = "[";
+    const int dim = dimension_of(scene.geometry);
+    for (std::size_t k = 0; k < t.regions.size(); ++k) {
+        const auto& r = t.regions[k];
+        const auto components = [&](const std::array<double, 3>& v) {
+            std::string out = "{";
+            for (int c = 0; c < dim; ++c) {
+                if (r.held[c]) out += fmt::format("{}\"{}\": {}", out.size() > 1 ? ", " : "", component_letter(dim, c), json_number(v[c]));
+            }
+            return out + "}";
+        };
+        regions += fmt::format("{}{{\"name\": {}, \"nodes\": {}, \"velocity_m_s\": {}, \"displacement_m\": {}, \"reaction_N\": {}, "
+                               "\"impulse_N_s\": {}, \"work_J\": {}}}",
+                               k ? ", " : "", json_string(r.name), r.nodes, components(r.velocity), components(r.displacement),
+                               components(r.reaction), components(r.impulse), json_number(r.work));
+    }
+    field("prescribed_velocities", regions + "]");
     std::string bodies = "[";
-    const int dim = scene.geometry == GeometryKind::ThreeD ? 3 : 2;
     for (std::size_t k = 0; k < t.bodies.size(); ++k) {
         const auto& b = t.bodies[k];
         const auto vec = [&](const std::array<double, 3>& v) {

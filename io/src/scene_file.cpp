@@ -25,7 +25,8 @@ using D = Dimension;
 constexpr std::uintmax_t max_scene_file_bytes = 16u << 20;
 
 const std::vector<std::string_view> scene_keys{
-    "name", "description", "geometry", "material", "body", "plane", "solver", "stop", "output", "reference",
+    "name", "description", "geometry", "material", "body", "plane", "prescribed_velocity", "solver", "stop", "output",
+    "reference",
 };
 const std::vector<std::string_view> body_keys{
     "name",    "shape",     "material", "origin",         "size",         "radius",            "diameter",
@@ -33,6 +34,8 @@ const std::vector<std::string_view> body_keys{
     "discretisation",
 };
 const std::vector<std::string_view> plane_keys{"name", "kind", "axis", "position", "side", "lift_off"};
+const std::vector<std::string_view> prescribed_keys{"name", "body", "region", "velocity", "ramp"};
+const std::vector<std::string_view> region_keys{"box", "above", "below", "beyond_radius", "within_radius"};
 const std::vector<std::string_view> solver_keys{
     "connectivity", "switch_plastic_strain", "influence_distance", "weight",          "viscosity",
     "normalisation", "viscosity_linear", "viscosity_quadratic", "bond_viscosity_eps0", "hourglass_coefficient", "smoothing",     "smoothing_coefficient",
@@ -295,6 +298,131 @@ PlaneSpec read_plane(const Reporter& reporter, const toml::table& table, std::si
     return p;
 }
 
+// --- prescribed velocities ------------------------------------------------------------------
+
+// The component names of a geometry ("x", "z" or "x", "y", "z").
+std::vector<std::string_view> component_names(int dim) {
+    return dim == 2 ? std::vector<std::string_view>{"x", "z"} : std::vector<std::string_view>{"x", "y", "z"};
+}
+
+// A table of per-component values (velocity = { z = "5 m/s" }, above = { z = "38 mm" }): the
+// component index and the node of each key given. A name the geometry does not have is an error
+// that says which it has.
+std::vector<std::pair<int, const toml::node*>> component_table(const TableReader& parent, std::string_view key,
+                                                               GeometryKind geometry, std::string_view example) {
+    const toml::node* node = parent.find(key);
+    const auto* table = node->as_table();
+    if (!table) {
+        parent.fail_at(key, fmt::format("expected a table of components such as {}, got {}", example, type_name(*node)));
+    }
+    const int dim = dimension_of(geometry);
+    const auto names = component_names(dim);
+    for (const auto& [name, value] : *table) {
+        const std::string_view k = name.str();
+        const std::string where = fmt::format("{}.{}", parent.key_path(key), printable(k));
+        if (dim == 2 && k == "y") {
+            parent.reporter().fail(line_of(value), where, fmt::format("{} has no y component: its components are x and z",
+                                                                      scene_phrase(geometry)));
+        }
+        if (geometry == GeometryKind::Axisymmetric && (k == "r" || k == "radial")) {
+            parent.reporter().fail(line_of(value), where, "the radial component of an axisymmetric scene is called x");
+        }
+    }
+    const TableReader t(parent.reporter(), *table, parent.key_path(key), fmt::format("a table of components in {}", scene_phrase(geometry)),
+                        names);
+    if (table->empty()) parent.fail_at(key, fmt::format("is empty: give at least one component, such as {}", example));
+    std::vector<std::pair<int, const toml::node*>> out;
+    for (int c = 0; c < dim; ++c) {
+        if (const toml::node* v = t.find(names[static_cast<std::size_t>(c)])) out.emplace_back(c, v);
+    }
+    return out;
+}
+
+PrescribedVelocitySpec read_prescribed_velocity(const Reporter& reporter, const toml::table& table, std::size_t index,
+                                                GeometryKind geometry) {
+    const TableReader r(reporter, table, labelled_path("prescribed_velocity", table, index), "a prescribed velocity",
+                        prescribed_keys);
+    const int dim = dimension_of(geometry);
+    const std::string_view components = components_of(dim);
+    PrescribedVelocitySpec p;
+    p.name = r.string("name").value_or(fmt::format("velocity{}", index));
+    if (p.name.empty()) r.fail_at("name", "a prescribed velocity's name must not be empty (leave the key out for \"velocity<index>\")");
+    p.body = r.required_string("body", "the name of the body whose nodes it holds");
+
+    // The region: every condition given must hold.
+    const toml::node* region_node = r.find("region");
+    if (!region_node) {
+        r.fail_missing("region", "the nodes it holds, e.g. region = { above = { z = \"38 mm\" } } (keys box, above, below, "
+                                 "beyond_radius, within_radius)");
+    }
+    const auto* region_table = region_node->as_table();
+    if (!region_table) {
+        r.fail_at("region", fmt::format("expected a table such as {{ above = {{ z = \"38 mm\" }} }}, got {}", type_name(*region_node)));
+    }
+    const TableReader g(reporter, *region_table, r.key_path("region"), "a region", region_keys);
+    if (region_table->empty()) r.fail_at("region", "is empty: give box, above, below, beyond_radius or within_radius");
+    std::array<const char*, 3> lower_from{nullptr, nullptr, nullptr}, upper_from{nullptr, nullptr, nullptr};
+    const auto bound = [&](std::string_view key, int c, double value, bool lower, const char* from) {
+        auto& source = lower ? lower_from[c] : upper_from[c];
+        if (source) {
+            g.fail_at(key, fmt::format("gives the {} bound of {} that {} gives already", lower ? "lower" : "upper",
+                                       component_names(dim)[static_cast<std::size_t>(c)], source));
+        }
+        source = from;
+        (lower ? p.lower : p.upper)[static_cast<std::size_t>(c)] = value;
+    };
+    if (g.has("box")) {
+        const auto* box = g.find("box")->as_table();
+        if (!box) g.fail_at("box", fmt::format("expected a table {{ min = {}, max = {} }}, got {}", components, components, type_name(*g.find("box"))));
+        const TableReader b(reporter, *box, g.key_path("box"), "a box", {"min", "max"});
+        const auto lo = b.quantities("min", D::Length, static_cast<std::size_t>(dim), Limit::Any, components);
+        const auto hi = b.quantities("max", D::Length, static_cast<std::size_t>(dim), Limit::Any, components);
+        if (!lo) b.fail_missing("min", fmt::format("the lower corner {}", components));
+        if (!hi) b.fail_missing("max", fmt::format("the upper corner {}", components));
+        for (int c = 0; c < dim; ++c) {
+            if ((*lo)[c] > (*hi)[c]) {
+                b.fail_at("max", fmt::format("lies below min along {} ({} < {} m)", component_names(dim)[static_cast<std::size_t>(c)],
+                                             (*hi)[c], (*lo)[c]));
+            }
+            bound("box", c, (*lo)[c], true, "box");
+            bound("box", c, (*hi)[c], false, "box");
+        }
+    }
+    for (const auto& [key, lower] : {std::pair<std::string_view, bool>{"above", true}, {"below", false}}) {
+        if (!g.has(key)) continue;
+        for (const auto& [c, node] : component_table(g, key, geometry, "{ z = \"38 mm\" }")) {
+            const double value = read_quantity(reporter, *node, fmt::format("{}.{}", g.key_path(key),
+                                                                            component_names(dim)[static_cast<std::size_t>(c)]),
+                                               D::Length, Limit::Any);
+            bound(key, c, value, lower, lower ? "above" : "below");
+        }
+    }
+    if (const auto v = g.quantity("beyond_radius", D::Length, Limit::NonNegative)) p.radius_min = *v;
+    if (const auto v = g.quantity("within_radius", D::Length, Limit::Positive)) p.radius_max = *v;
+    if (p.radius_min > p.radius_max) {
+        g.fail_at("within_radius", fmt::format("{} m is less than beyond_radius = {} m: no radius is in both", p.radius_max, p.radius_min));
+    }
+
+    // The velocity: a table of the prescribed components, or an array of all of them.
+    const toml::node* velocity = r.find("velocity");
+    if (!velocity) {
+        r.fail_missing("velocity", fmt::format("the prescribed components, e.g. velocity = {{ z = \"5 m/s\" }}, or all of them, "
+                                               "velocity = {}", components));
+    }
+    if (velocity->is_array()) {
+        const auto all = r.quantities("velocity", D::Velocity, static_cast<std::size_t>(dim), Limit::Any, components);
+        for (int c = 0; c < dim; ++c) p.velocity[static_cast<std::size_t>(c)] = (*all)[static_cast<std::size_t>(c)];
+    } else {
+        for (const auto& [c, node] : component_table(r, "velocity", geometry, "{ z = \"5 m/s\" }")) {
+            p.velocity[static_cast<std::size_t>(c)] =
+                read_quantity(reporter, *node, fmt::format("{}.{}", r.key_path("velocity"), component_names(dim)[static_cast<std::size_t>(c)]),
+                              D::Velocity, Limit::Any);
+        }
+    }
+    if (const auto ramp = r.quantity("ramp", D::Time, Limit::NonNegative)) p.ramp = *ramp;
+    return p;
+}
+
 // --- options -------------------------------------------------------------------------------
 
 SolverOptions read_solver(const Reporter& reporter, const toml::table& table) {
@@ -416,7 +544,7 @@ void read_reference(const Reporter& reporter, const toml::table& table, Scene& s
     }
 }
 
-Scene read_scene(std::string_view text, const Reporter& reporter) {
+Scene read_scene(std::string_view text, const Reporter& reporter, std::vector<std::size_t>& region_lines) {
     check_text(text, reporter);
     const toml::table root = parse_toml(text, reporter);
     if (root.empty()) {
@@ -445,6 +573,11 @@ Scene read_scene(std::string_view text, const Reporter& reporter) {
     for (std::size_t i = 0; i < plane_tables.size(); ++i) {
         scene.planes.push_back(read_plane(reporter, *plane_tables[i], i, scene.geometry));
     }
+    const auto region_tables = tables_of(top, "prescribed_velocity");
+    for (std::size_t i = 0; i < region_tables.size(); ++i) {
+        scene.prescribed_velocities.push_back(read_prescribed_velocity(reporter, *region_tables[i], i, scene.geometry));
+        region_lines.push_back(line_of(*region_tables[i]));
+    }
     scene.materials = scene_materials.take();
 
     const toml::table empty;
@@ -459,11 +592,15 @@ Scene read_scene(std::string_view text, const Reporter& reporter) {
 
 Scene parse_scene(std::string_view text, const std::string& file_name_for_messages) {
     const Reporter reporter(file_name_for_messages);
-    Scene scene = read_scene(text, reporter);
-    // The scene-level rules (shapes for the geometry, planes, spacings, option ranges, materials)
-    // are the engine's, the same for a Scene built in code.
+    std::vector<std::size_t> region_lines;
+    Scene scene = read_scene(text, reporter, region_lines);
+    // The scene-level rules (shapes for the geometry, planes, spacings, option ranges, materials,
+    // the nodes of prescribed-velocity regions) are the engine's, the same for a Scene built in
+    // code; an error about one region points at its table.
     try {
         validate_scene(scene);
+    } catch (const PrescribedVelocityError& e) {
+        reporter.fail(e.index() < region_lines.size() ? region_lines[e.index()] : 0, "", e.what());
     } catch (const InputError& e) {
         reporter.fail(0, "", e.what());
     }

@@ -436,7 +436,7 @@ const std::vector<MetricInfo>& study_metrics() {
         {"contact_time", "s", "us", 1e6, true, "time from the onset of contact with the first rigid plane to lift-off"},
         {"rebound_speed", "m/s", "m/s", 1.0, true, "|momentum along the plane normal| / mass after lift-off"},
         {"plastic_work", "J", "J", 1.0, true, "plastic work at the end"},
-        {"energy_error", "", "%", 100.0, false, "(KE + IE + boundary work - E0) / E0 at the end"},
+        {"energy_error", "", "%", 100.0, false, "(KE + IE + boundary work - E0) / (E0 + positive prescribed-velocity work) at the end"},
         {"variable_fraction", "", "%", 100.0, false, "share of the real nodes with variable connectivity at the end"},
         {"hourglass_work", "J", "J", 1.0, false, "work of the hourglass control of lattice-regime nodes at the end"},
     };

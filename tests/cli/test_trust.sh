@@ -158,6 +158,34 @@ for f in every-whole/particles_*.vtp every-whole/history.csv; do
   cmp -s "$f" "killed/$(basename "$f")" || fail "resumed after kill -9: $(basename "$f") differs"
 done
 
+# A run with prescribed velocities (the bar clamped on the anvil and pulled at its top) resumes
+# from its last periodic checkpoint with its regions' bookings: the same history.
+variant pulled.toml -e 's/^velocity = .*//' -e 's/^max_steps = 20/max_steps = 3000/' -e 's/^snapshots = 3/snapshots = 3\ncheckpoint_every = 500/'
+cat >> pulled.toml <<'TOML'
+
+[[prescribed_velocity]]
+name = "grip"
+body = "bar"
+region = { above = { z = "3.5 mm" } }
+velocity = { z = "5 m/s" }
+ramp = "1 us"
+
+[[prescribed_velocity]]
+name = "foot"
+body = "bar"
+region = { below = { z = "0.5 mm" } }
+velocity = { z = 0 }
+TOML
+expect 0 "pulled: whole" -- "$gpa" run pulled.toml -o pulled-whole -q --threads 1
+head -1 pulled-whole/history.csv | grep -q ',grip_reaction_z_N,grip_impulse_z_N_s,grip_displacement_z_m,grip_work_J,foot_reaction_z_N' ||
+  fail "pulled: history columns $(head -1 pulled-whole/history.csv)"
+"$gpa" run pulled.toml -o pulled-killed -q --threads 2 > /dev/null 2>&1 &
+pid=$!
+wait_for_file pulled-killed.partial/checkpoint.gpack || fail "pulled: no periodic checkpoint"
+kill -9 $pid; wait $pid 2> /dev/null
+expect 0 "pulled: resume after kill -9" -- "$gpa" run --resume pulled-killed -q --threads 1
+cmp -s pulled-whole/history.csv pulled-killed/history.csv || fail "pulled: the resumed history differs"
+
 # What cannot be resumed is refused.
 expect 2 "resume a finished run" -- "$gpa" run --resume whole -q
 says err.txt "has finished" "resume a finished run"

@@ -423,6 +423,53 @@ TEST(SceneFile, QuotedTextCannotBreakTheMessageLine) {
 
 // The examples of docs/scene-format.md read as they claim: whole scenes as scenes, [[material]]
 // examples as a material library.
+TEST(SceneFile, PrescribedVelocitiesReadTheirRegionVelocityAndRamp) {
+    const std::string text = R"toml(
+geometry = "axisymmetric"
+[[body]]
+name = "bar"
+shape = "cylinder"
+material = "4340 steel"
+radius = "2 mm"
+length = "20 mm"
+spacing = "0.25 mm"
+[[prescribed_velocity]]
+name = "grip"
+body = "bar"
+region = { above = { z = "19 mm" }, within_radius = "1.5 mm" }
+velocity = { z = "2 m/s" }
+ramp = "5 us"
+[[prescribed_velocity]]
+body = "bar"
+region = { box = { min = [0, 0], max = ["2 mm", "1 mm"] }, beyond_radius = "0.5 mm" }
+velocity = [0, 0]
+[stop]
+end_time = "10 us"
+)toml";
+    const Scene s = parse_scene(text, "grip.toml");
+    ASSERT_EQ(s.prescribed_velocities.size(), 2u);
+    const auto& grip = s.prescribed_velocities[0];
+    EXPECT_EQ(grip.name, "grip");
+    EXPECT_EQ(grip.body, "bar");
+    EXPECT_EQ(grip.lower[1], 0.019);
+    EXPECT_EQ(grip.upper[1], INFINITY);
+    EXPECT_EQ(grip.lower[0], -INFINITY);
+    EXPECT_EQ(grip.radius_min, 0.0);
+    EXPECT_EQ(grip.radius_max, 0.0015);
+    EXPECT_FALSE(grip.velocity[0].has_value());
+    EXPECT_EQ(grip.velocity[1], 2.0);
+    EXPECT_FALSE(grip.velocity[2].has_value());
+    EXPECT_EQ(grip.ramp, 5e-6);
+    const auto& clamp = s.prescribed_velocities[1];
+    EXPECT_EQ(clamp.name, "velocity1");
+    EXPECT_EQ(clamp.lower, (std::array<double, 3>{0.0, 0.0, -INFINITY}));
+    EXPECT_EQ(clamp.upper, (std::array<double, 3>{0.002, 0.001, INFINITY}));
+    EXPECT_EQ(clamp.radius_min, 0.0005);
+    EXPECT_EQ(clamp.velocity[0], 0.0);
+    EXPECT_EQ(clamp.velocity[1], 0.0);
+    EXPECT_EQ(clamp.ramp, 0.0);
+}
+
 TEST(SceneFile, DocumentationExamplesParse) {
     std::ifstream in(GPA_SCENE_FORMAT_DOC);
     ASSERT_TRUE(in) << GPA_SCENE_FORMAT_DOC;

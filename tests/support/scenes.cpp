@@ -1,5 +1,6 @@
 #include "support/scenes.hpp"
 
+#include <cmath>
 #include <sstream>
 
 #include "gpa/engine/state_io.hpp"
@@ -44,6 +45,46 @@ Scene elastic_bar_on_plane(double radius, double length, int radial_cells, doubl
     s.solver.viscosity = ViscosityKind::None;
     s.solver.connectivity = ConnectivityMode::Variable;
     s.stop.end_time = 3.0 * length / 5000.0;
+    return s;
+}
+
+Scene pulled_elastic_bar(GeometryKind geometry, double radius, double length, int radial_cells, double speed, double ramp,
+                         double poisson) {
+    Scene s;
+    s.name = "pulled elastic bar";
+    s.geometry = geometry;
+    s.materials.push_back(elastic_material("elastic steel", 7800.0, 200e9, poisson));
+    BodySpec bar;
+    bar.name = "bar";
+    bar.spacing = radius / radial_cells;
+    bar.material = "elastic steel";
+    const int axial = geometry == GeometryKind::ThreeD ? 2 : 1;
+    if (geometry == GeometryKind::ThreeD) {
+        bar.shape = ShapeKind::Box;
+        bar.origin = {-radius, -radius, 0.0};
+        bar.size = {2.0 * radius, 2.0 * radius, length};
+    } else {
+        bar.shape = ShapeKind::Cylinder;
+        bar.radius = radius;
+        bar.length = length;
+    }
+    s.bodies.push_back(bar);
+    const double dz = bar.spacing;
+    PrescribedVelocitySpec grip;
+    grip.name = "grip";
+    grip.body = "bar";
+    grip.lower[axial] = length - 2.25 * dz;  // between rows: particle rows at (k + 1/2) dz, element nodes at k dz / 2
+    grip.velocity[axial] = speed;
+    grip.ramp = ramp;
+    s.prescribed_velocities.push_back(grip);
+    PrescribedVelocitySpec clamp;
+    clamp.name = "clamp";
+    clamp.body = "bar";
+    clamp.upper[axial] = 2.25 * dz;
+    clamp.velocity[axial] = 0.0;
+    s.prescribed_velocities.push_back(clamp);
+    s.solver.viscosity = ViscosityKind::None;
+    s.stop.end_time = 3.0 * length / std::sqrt(200e9 / 7800.0);
     return s;
 }
 

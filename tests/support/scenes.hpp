@@ -15,6 +15,13 @@ materials::Material elastic_material(const std::string& name, double density, do
 // allowed) and moving towards it at `speed`; spacing = R / radial_cells.
 Scene elastic_bar_on_plane(double radius, double length, int radial_cells, double speed);
 
+// An elastic bar at rest (axisymmetric cylinder of radius R and length L, or the plane-strain strip
+// or 3D square bar of width 2R), spacing dz = R / radial_cells, no viscosity: its nodes within
+// 2.25 dz of the top ("grip", two rows of particles) are pulled along z at `speed` after a linear
+// ramp over `ramp`, those within 2.25 dz of the bottom ("clamp") held at v_z = 0 (x, y free).
+Scene pulled_elastic_bar(GeometryKind geometry, double radius, double length, int radial_cells, double speed, double ramp,
+                         double poisson);
+
 // Every field of every node of a run (ghosts included) and the fixed lists, as bytes (the
 // checkpoint encoding of NodeStore): for comparing runs bit for bit.
 std::string node_bytes(const Simulation& sim);

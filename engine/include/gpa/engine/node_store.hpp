@@ -67,6 +67,7 @@ public:
     std::vector<double> viscous_work;              // accumulated specific artificial-viscous work, J/kg
     std::vector<std::uint8_t> failed;              // 1 once the node has failed (no deviator, no tension)
     std::vector<std::uint8_t> plane_contact;       // bit p: in contact with lift-off plane p (ghosts.hpp)
+    std::vector<std::uint8_t> velocity_region;     // 0: free; k + 1: held by Scene::prescribed_velocities[k] (prescribed.hpp)
     std::vector<std::int32_t> body;
     std::vector<std::int32_t> material;
     std::vector<Connectivity> connectivity;

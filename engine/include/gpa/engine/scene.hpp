@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "gpa/engine/colouring.hpp"
+#include "gpa/engine/errors.hpp"
 #include "gpa/engine/geometry.hpp"
 #include "gpa/engine/weights.hpp"
 #include "gpa/materials/material.hpp"
@@ -97,6 +98,29 @@ struct PlaneSpec {
     bool lift_off = true;   // rigid only: false = the paper's no-lift-off (nodes on it may not leave)
 };
 
+// Nodes of one body held at a prescribed velocity (a grip, a clamp, a piston): every node of
+// `body` inside the region at t = 0 keeps, in each prescribed component, the velocity
+//   v(t) = value * min(t / ramp, 1)   (ramp > 0: a linear ramp from 0, then constant)
+//   v(t) = value                      (ramp = 0)
+// from t = 0 on; the other components move freely. The region is the nodes whose initial
+// position p has lower[c] <= p[c] <= upper[c] on every axis and a distance from the body's axis
+// within [radius_min, radius_max]. The body's axis is the line along z through the centre of its
+// extent across z (for cylinders, plates and spheres their own axis; in axisymmetric geometry
+// x = 0, so the distance is x). The force the nodes need to follow the motion is the region's
+// reaction; its work is booked as boundary work (simulation.hpp, Totals::regions).
+struct PrescribedVelocitySpec {
+    std::string name;
+    std::string body;  // a name in Scene::bodies
+    std::array<double, 3> lower{-std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity(),
+                                -std::numeric_limits<double>::infinity()};
+    std::array<double, 3> upper{std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
+                                std::numeric_limits<double>::infinity()};
+    double radius_min = 0.0;
+    double radius_max = std::numeric_limits<double>::infinity();
+    std::array<std::optional<double>, 3> velocity;  // m/s per component (first dim entries); empty = free
+    double ramp = 0.0;                              // s
+};
+
 // How the internal energy follows the stress (spec section 5, "[spec] Compatible energy").
 enum class EnergyUpdate {
     Compatible,  // the work of each node's stress forces at the mean velocities of the velocity update
@@ -173,6 +197,7 @@ struct Scene {
     std::vector<materials::Material> materials;
     std::vector<BodySpec> bodies;
     std::vector<PlaneSpec> planes;
+    std::vector<PrescribedVelocitySpec> prescribed_velocities;
     SolverOptions solver;
     StopCriteria stop;
     OutputOptions output;
@@ -185,6 +210,19 @@ struct Scene {
 // Throws InputError naming the body, plane or option when the scene is impossible (no bodies,
 // a body with a non-positive size or spacing, an unknown material name, a plane on a body's
 // wrong side, an option out of its range, a missing end condition, ...).
+// The checks of one prescribed-velocity region fail with this error (its index says which entry, so
+// that a scene reader can name the line): an unknown body, no component, a negative ramp, a region
+// outside the body or holding none of its nodes, two regions sharing a node, a region that would
+// move nodes through a plane they touch.
+class PrescribedVelocityError : public InputError {
+public:
+    PrescribedVelocityError(const std::string& message, std::size_t index) : InputError(message), index_(index) {}
+    std::size_t index() const { return index_; }
+
+private:
+    std::size_t index_;
+};
+
 void validate_scene(const Scene& scene);
 
 }  // namespace gpa

@@ -10,7 +10,8 @@
 //   ghost stresses, the scatter plan                      plan
 //   dt^{n+3/2} = C_cfl min l / (c + sqrt(Q / rho))        time step
 //   F^{n+1} from sigma^{n+1}                              forces
-//   v^{n+3/2} = v^{n+1/2} + (dt^{n+1/2} + dt^{n+3/2})/2 F / M   integrate, [smoothing]
+//   v^{n+3/2} = v^{n+1/2} + (dt^{n+1/2} + dt^{n+3/2})/2 F / M   integrate, then the held components of
+//     prescribed-velocity regions set (prescribed.hpp), [smoothing] (held components left alone)
 //   lattice cells checked; fixed -> variable above the    [switching]
 //     plastic-strain threshold or where a cell collapsed
 //
@@ -23,6 +24,7 @@
 // half step ahead (v^{n+3/2}), and the kinetic energy reported for t^{n+1} is the mean of the two
 // half steps around it.
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <istream>
@@ -47,6 +49,30 @@ struct PlaneReport {
     double impulse = 0.0;   // time integral of the reaction since t = 0 (N s)
 };
 
+// A prescribed-velocity region (scene.hpp, PrescribedVelocitySpec; prescribed.hpp). Reaction and
+// impulse are ring totals in axisymmetric geometry, like a plane's; components that the region
+// leaves free read 0.
+struct RegionReport {
+    std::string name;
+    std::array<bool, 3> held{false, false, false};  // the components it prescribes
+    std::size_t nodes = 0;                          // nodes it holds
+    std::array<double, 3> velocity{0, 0, 0};        // the prescribed velocity at this time, m/s
+    std::array<double, 3> displacement{0, 0, 0};    // of its nodes since t = 0 along the held components, m
+    // The force its nodes need to follow the prescribed motion, M a_prescribed - F_internal summed
+    // over them, of the last step (F^{n+1}: the reaction that takes v^{n+1/2} to v^{n+3/2}), N.
+    std::array<double, 3> reaction{0, 0, 0};
+    // The momentum it has given the bodies since t = 0, half a step ahead like Totals::momentum:
+    // the time integral of the reaction, plus what velocity smoothing moved across its boundary
+    // (smoothing.hpp), N s.
+    std::array<double, 3> impulse{0, 0, 0};
+    // The work it has done on the bodies since t = 0 (the time integral of reaction . velocity,
+    // prescribed.hpp), J, up to the instant of the energy balance's kinetic energy: through the
+    // last velocity update (half a step ahead, like the impulse) with the compatible energy update
+    // of particle bodies, up to t^{n+1} otherwise. The balance books it as boundary work of the
+    // opposite sign.
+    double work = 0.0;
+};
+
 struct Totals {
     double time = 0.0;
     double time_step = 0.0;  // dt^{n+1/2}, the step that led here
@@ -56,13 +82,17 @@ struct Totals {
     double plastic_work = 0.0;     // sum M w_p, J
     double viscous_work = 0.0;     // work of artificial viscosity (nodal, bond and hourglass control), J
     double hourglass_work = 0.0;   // the part of viscous_work done by the hourglass control of fixed nodes, J
-    double boundary_work = 0.0;    // energy removed by velocity constraints, J
+    double boundary_work = 0.0;    // energy removed by velocity constraints (less the work of prescribed velocities), J
     double initial_kinetic_energy = 0.0;  // J
     double initial_energy = 0.0;   // kinetic + internal at t = 0, J
-    double energy_error = 0.0;     // (KE + IE + boundary work - E0) / E0
+    // The energy the run was given: E0, plus the work of the prescribed velocities when they
+    // have put energy in (a bar pulled from rest has E0 = 0), J.
+    double energy_given = 0.0;
+    double energy_error = 0.0;     // (KE + IE + boundary work - E0) / energy_given
     std::array<double, 3> momentum{0, 0, 0};  // sum M v^{n+3/2}, kg m/s: half a step ahead, like the impulse
                                               // (the axial component is the meaningful one in axisymmetric)
     std::vector<PlaneReport> planes;          // rigid planes, scene order
+    std::vector<RegionReport> regions;        // prescribed-velocity regions, scene order
     // Every body of the scene, scene order (element bodies carry zeros): energies and momentum every
     // step; pieces, residual velocity and crater (body_report.hpp) as of the last measure_bodies().
     std::vector<BodyTotals> bodies;
@@ -143,11 +173,12 @@ public:
     // --- checkpoints --------------------------------------------------------------------------
     // Writes everything later steps depend on (every node field, the ghosts, the neighbour lists
     // and their candidates with the positions and diameters of the last search, the scatter
-    // plan, both time steps, the half-step kinetic energy, impulses, boundary work, counters,
-    // totals and phase times), so that a Simulation built from the same scene and restored from
-    // it continues bit-identically to one never stopped, on any thread count. The file is
-    // versioned and carries build_id(), `scene_fingerprint` (what identifies the scene to the
-    // caller, e.g. a hash of its file) and `user_data` (anything the caller wants back).
+    // plan, both time steps, the half-step kinetic energy, impulses, boundary work, the bookings
+    // of the prescribed velocities, counters, totals and phase times), so that a Simulation built
+    // from the same scene and restored from it continues bit-identically to one never stopped, on
+    // any thread count. The file is versioned and carries build_id(), `scene_fingerprint` (what
+    // identifies the scene to the caller, e.g. a hash of its file) and `user_data` (anything the
+    // caller wants back).
     void save_checkpoint(std::ostream& out, std::string_view scene_fingerprint, std::string_view user_data = {}) const;
     // False for scenes with element bodies: their state is not in the checkpoint format yet, and
     // save_checkpoint refuses them (InputError) rather than write one that would not resume exactly.

@@ -66,6 +66,7 @@ private:
     std::filesystem::path path_;
     int dim_;
     std::size_t planes_;
+    std::vector<std::array<bool, 3>> regions_;  // the held components of each prescribed-velocity region
 };
 
 // What one snapshot shows, copied out of a run so that it can be written while the run goes on:
