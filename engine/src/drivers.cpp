@@ -249,10 +249,10 @@ void stress_power_impl(const CompressedRows& lists, const ForceFields<G::dim>& f
             double sum = 0.0, divergence = 0.0;
             for (NodeIndex j : lists.row(i)) {
                 const auto p = f.pairs.template pair<W>(i, j);
-                const Vec<D> n = normalisation * p.l;
+                const Vec<D> normalised_l = normalisation * p.l;
                 const Vec<D> dv = load<D>(velocity, j) - v_i;
-                sum += pair_force(p, volume, f.size_weight[j], n, sigma, 0.0).dot(dv);  // Eq. 21-22
-                divergence += p.R * f.size_weight[j] * p.inv_r * n.dot(dv);
+                sum += pair_force(p, volume, f.size_weight[j], normalised_l, sigma, 0.0).dot(dv);  // Eq. 21-22
+                divergence += p.R * f.size_weight[j] * p.inv_r * normalised_l.dot(dv);
             }
             if constexpr (G::axisymmetric) {
                 const double hoop = hoop_force(out_of_plane_stress(f.deviatoric_stress, f.pressure, f.viscous_pressure, i), volume,

@@ -99,7 +99,6 @@ struct Simulation::Impl {
     // and solver.separate_failed; decided every step before the velocity gradient.
     bool with_separation = false;
     bool separate_failed = false;
-    SeparationCounts separation;
     std::vector<double> closing_speed;     // per real node (separation.hpp); empty without separation
     ImpactFrame impact;                    // body_report.hpp, from the initial state
     std::vector<double> body_kinetic_half; // per body, like kinetic_half
@@ -187,7 +186,7 @@ struct Simulation::Impl {
     void book_regions(const std::vector<RegionStep>& step, double dt_avg);
     void advance_region_displacements(double dt);
     void sum_totals();
-    void sum_body_totals(bool advance_kinetic);
+    void sum_body_totals(bool advance_kinetic, const Sums* particle_sums = nullptr);
     measure::Extent element_extent(const GhostPlane& plane, bool axisymmetric) const;
     void regroup_materials();
 };
@@ -523,7 +522,7 @@ void Simulation::Impl::neighbours() {
         filter_candidates(nodes, a(), candidates, lattice_entries, lists, keep_scratch);
         if (!ghosts.empty()) ghosts.remove_pairs_without_contact(lists, nodes, real);
         if (scene.solver.check_neighbour_lists) check_lists_against_search();
-        if (with_separation) separation = remove_open_pairs(lists, nodes, real, separate_failed, closing_speed.data());
+        if (with_separation) remove_open_pairs(lists, nodes, real, separate_failed, closing_speed.data());
         if (!ghosts.empty()) ghosts.append_ghost_rows(lists, real);
         return;
     }
@@ -531,13 +530,13 @@ void Simulation::Impl::neighbours() {
     plan_due = true;
     if (ghosts.empty()) {
         find_neighbours(nodes, a(), real, lists, search_scratch);
-        if (with_separation) separation = remove_open_pairs(lists, nodes, real, separate_failed, closing_speed.data());
+        if (with_separation) remove_open_pairs(lists, nodes, real, separate_failed, closing_speed.data());
         return;
     }
     const CompressedRows& mirrored = ghosts.resolved_fixed_mirrors(nodes, real);
     find_neighbours(nodes, a(), real, lists, search_scratch, &mirrored);
     ghosts.remove_pairs_without_contact(lists, nodes, real);
-    if (with_separation) separation = remove_open_pairs(lists, nodes, real, separate_failed, closing_speed.data());
+    if (with_separation) remove_open_pairs(lists, nodes, real, separate_failed, closing_speed.data());
     ghosts.append_ghost_rows(lists, real);
 }
 
@@ -921,10 +920,30 @@ void Simulation::Impl::advance_region_displacements(double dt) {
     }
 }
 
-void Simulation::Impl::sum_body_totals(bool advance_kinetic) {
-    // Per body, the sums of sum_totals (one reduction with a slot per body; bodies are few).
+void Simulation::Impl::sum_body_totals(bool advance_kinetic, const Sums* particle_sums) {
+    // Per body, the sums of sum_totals (one reduction with a slot per body; bodies are few). A
+    // scene of one body takes sum_totals' own sums instead of a second pass over the nodes.
     const int d = dim();
     const std::size_t bodies = scene.bodies.size();
+    if (bodies == 1 && particle_sums) {
+        totals.bodies.resize(1);
+        BodyTotals& t = totals.bodies[0];
+        t.name = scene.bodies[0].name;
+        if (t.mass == 0.0) t.mass = std::accumulate(nodes.mass.begin(), nodes.mass.begin() + real, 0.0);
+        if (advance_kinetic) {
+            t.kinetic_energy = 0.5 * (body_kinetic_half[0] + particle_sums->kinetic);
+            body_kinetic_half[0] = particle_sums->kinetic;
+        }
+        t.internal_energy = particle_sums->internal;
+        for (int c = 0; c < 3; ++c) {
+            t.momentum[c] = c < d ? particle_sums->momentum[c] : 0.0;
+            t.centre_velocity[c] = t.mass > 0.0 ? t.momentum[c] / t.mass : 0.0;
+        }
+        t.nodes = real;
+        t.failed_nodes = particle_sums->failed;
+        t.target = impact.defined && impact.target[0];
+        return;
+    }
     struct BodySums {
         std::vector<double> values;  // per body: mass, kinetic, internal, momentum[3], nodes, failed
         BodySums& operator+=(const BodySums& o) {
@@ -1074,7 +1093,7 @@ void Simulation::Impl::sum_totals() {
         const double element_impulse = elements ? elements->impulses()[k] : 0.0;
         totals.planes.push_back({ghosts.planes()[rigid_planes[k]].name, reaction[k] + element_reaction, impulse[k] + element_impulse});
     }
-    sum_body_totals(true);
+    sum_body_totals(true, &s);
     totals.energy_given = totals.initial_energy + std::max(0.0, region_work_now);
     if (totals.energy_given != 0.0) {
         // With the compatible energy update the internal energy has been booked up to the velocities
