@@ -166,6 +166,9 @@ int main(int argc, char** argv) {
     render->add_flag("--no-mirror", render_options.no_mirror, "2D: do not mirror an axisymmetric run")->excludes(render_mirror);
     render->add_option("--view", render_options.view,
                        "3D: the direction the picture looks along, +x, -x, +y, -y, +z or -z (default +y: x right, z up)");
+    render->add_option("--region", render_options.region,
+                       "draw only this window, LEFT:RIGHT,BOTTOM:TOP in the picture's axes (2D: x and z), e.g. -30mm:30mm,-10mm:20mm "
+                       "(plain numbers in m)");
     render->add_option("--geometry", render_options.geometry,
                        "axisymmetric, plane-strain or 3d (default: the run's scene.toml or summary.json)");
     render->add_flag("--list", render_options.list, "list the snapshots and the fields of the chosen one, and draw nothing");

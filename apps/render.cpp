@@ -1,6 +1,7 @@
 #include "render.hpp"
 
 #include <algorithm>
+#include <array>
 #include <charconv>
 #include <cmath>
 #include <regex>
@@ -51,6 +52,38 @@ double range_end(const std::string& text, const std::string& field, const std::s
     } catch (const io::UnitError& e) {
         throw InputError(fmt::format("--range '{}': '{}': {}", whole, text, e.what()));
     }
+}
+
+// --region LEFT:RIGHT,BOTTOM:TOP: four lengths, each a plain number (m) or with a unit ("30 mm").
+std::array<double, 4> region_named(const std::string& text) {
+    const auto comma = text.find(',');
+    const std::string expected = "expected LEFT:RIGHT,BOTTOM:TOP, e.g. -30mm:30mm,-10mm:20mm (plain numbers in m)";
+    if (comma == std::string::npos) throw InputError(fmt::format("--region '{}': {}", text, expected));
+    std::array<double, 4> out{};
+    const std::array<std::string, 2> halves{text.substr(0, comma), text.substr(comma + 1)};
+    for (int h = 0; h < 2; ++h) {
+        const auto colon = halves[h].find(':');
+        if (colon == std::string::npos) throw InputError(fmt::format("--region '{}': {}", text, expected));
+        const std::array<std::string, 2> ends{halves[h].substr(0, colon), halves[h].substr(colon + 1)};
+        for (int e = 0; e < 2; ++e) {
+            double v = 0.0;
+            if (const auto plain = plain_number(ends[e])) {
+                v = *plain;
+            } else {
+                try {
+                    v = io::parse_quantity(ends[e], io::Dimension::Length);
+                } catch (const io::UnitError& err) {
+                    throw InputError(fmt::format("--region '{}': '{}': {} ({})", text, ends[e], err.what(), expected));
+                }
+            }
+            out[2 * h + e] = v;
+        }
+        if (!(out[2 * h] < out[2 * h + 1])) {
+            throw InputError(fmt::format("--region '{}': the {} range must end above where it starts", text,
+                                         h == 0 ? "horizontal (LEFT:RIGHT)" : "vertical (BOTTOM:TOP)"));
+        }
+    }
+    return out;
 }
 
 GeometryKind geometry_named(const std::string& text) {
@@ -151,6 +184,7 @@ int render_run(const RenderCommandOptions& o) {
         options.view = io::view_direction_named(o.view);
         if (!options.view) throw InputError(fmt::format("--view '{}': expected +x, -x, +y, -y, +z or -z", o.view));
     }
+    if (!o.region.empty()) options.region = region_named(o.region);
     if (o.mirror) options.mirror = true;
     if (o.no_mirror) options.mirror = false;
 

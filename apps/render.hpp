@@ -19,6 +19,7 @@ struct RenderCommandOptions {
     std::string range;             // "MIN:MAX", either side may be empty (the field's own)
     bool mirror = false, no_mirror = false;
     std::string view;              // 3D: "+y", "-z", ...
+    std::string region;            // "LEFT:RIGHT,BOTTOM:TOP", lengths with units or plain metres
     std::string geometry;          // override: axisymmetric, plane-strain, 3d
     bool list = false;
     bool quiet = false;

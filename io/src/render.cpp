@@ -592,6 +592,41 @@ Picture render_snapshot(const LoadedSnapshot& snapshot, GeometryKind geometry, c
     }
     picture.discs = mirror ? discs.size() / 2 : discs.size();
     picture.triangles = mirror ? triangles.size() / 2 : triangles.size();
+    if (options.region) {
+        // Keep what reaches into the window (mirrored images included: they are then counted as
+        // drawn nodes of their own).
+        const auto [left, right, bottom, top] = *options.region;
+        if (!(left < right) || !(bottom < top)) {
+            throw InputError(fmt::format("region {} to {} by {} to {}: each range must end above where it starts",
+                                         format_quantity(left, "m"), format_quantity(right, "m"), format_quantity(bottom, "m"),
+                                         format_quantity(top, "m")));
+        }
+        double umin = std::numeric_limits<double>::infinity(), umax = -umin, vmin = umin, vmax = -umin;
+        const auto inside = [&](double u, double v, double r) {
+            umin = std::min(umin, u - r);
+            umax = std::max(umax, u + r);
+            vmin = std::min(vmin, v - r);
+            vmax = std::max(vmax, v + r);
+            return u + r >= left && u - r <= right && v + r >= bottom && v - r <= top;
+        };
+        std::erase_if(discs, [&](const Disc& d) { return !inside(d.u, d.v, d.radius); });
+        std::erase_if(triangles, [&](const Triangle& t) {
+            bool any = false;
+            for (const auto& c : t.corner) any = inside(c.u, c.v, 0.0) || any;
+            const auto [ul, uh] = std::minmax({t.corner[0].u, t.corner[1].u, t.corner[2].u});
+            const auto [vl, vh] = std::minmax({t.corner[0].v, t.corner[1].v, t.corner[2].v});
+            return !(any || (uh >= left && ul <= right && vh >= bottom && vl <= top));
+        });
+        if (discs.empty() && triangles.empty()) {
+            throw InputError(fmt::format("snapshot {}: nothing to draw in the region {} to {} by {} to {}; the snapshot spans {} "
+                                         "to {} by {} to {}",
+                                         snapshot.index, format_quantity(left, "m"), format_quantity(right, "m"),
+                                         format_quantity(bottom, "m"), format_quantity(top, "m"), format_quantity(umin, "m"),
+                                         format_quantity(umax, "m"), format_quantity(vmin, "m"), format_quantity(vmax, "m")));
+        }
+        picture.discs = discs.size();
+        picture.triangles = triangles.size();
+    }
     if (three_d) {
         // Painter's order: the farthest first, the file's order among equals.
         const auto farther = [](const auto& a, const auto& b) { return a.depth > b.depth; };
@@ -674,9 +709,14 @@ Picture render_snapshot(const LoadedSnapshot& snapshot, GeometryKind geometry, c
         vmin = std::min(vmin, v - r);
         vmax = std::max(vmax, v + r);
     };
-    for (const auto& d : discs) extend(d.u, d.v, d.radius);
-    for (const auto& t : triangles) {
-        for (const auto& c : t.corner) extend(c.u, c.v, 0.0);
+    if (options.region) {
+        extend((*options.region)[0], (*options.region)[2], 0.0);
+        extend((*options.region)[1], (*options.region)[3], 0.0);
+    } else {
+        for (const auto& d : discs) extend(d.u, d.v, d.radius);
+        for (const auto& t : triangles) {
+            for (const auto& c : t.corner) extend(c.u, c.v, 0.0);
+        }
     }
     double world_w = umax - umin, world_h = vmax - vmin;
     const double world_size = std::max(world_w, world_h) > 0.0 ? std::max(world_w, world_h) : 1e-3;

@@ -41,6 +41,8 @@ expect 0 "render by time, width, range with units, into a folder" -- \
 [[ -s pressure-00001.png ]] || fail "no pressure-00001.png in the folder given"
 [[ $(png_size pressure-00001.png) == 400x* ]] || fail "pressure-00001.png is $(png_size pressure-00001.png), expected 400 wide"
 [[ -s out.txt ]] && fail "-q printed: $(cat out.txt)"
+expect 0 "render a region with units" -- "$gpa" render run --field pressure --region=-1mm:1mm,0:2mm -o region.png
+is_png region.png || fail "region.png is not a PNG"
 expect 0 "render the .pvd itself" -- "$gpa" render run/particles.pvd --field plastic_strain -o strain.png
 is_png strain.png || fail "strain.png is not a PNG"
 expect 0 "list" -- "$gpa" render run --list
@@ -75,6 +77,10 @@ refused "time not a time" "--time '3 mm'" run --time "3 mm"
 refused "range the wrong way" "must end above" run --field pressure --range 5:1
 refused "range without a colon" "--range '5'" run --field pressure --range 5
 refused "range of the wrong unit" "--range" run --field pressure --range "1 mm:2 mm"
+refused "region without a comma" "--region '0:1'" run --region 0:1
+refused "region the wrong way" "must end above" run --region=1mm:0mm,0:1mm
+refused "region of the wrong unit" "--region" run --region "0:1 s,0:1"
+refused "region missing the run" "nothing to draw in the region" run --region 1:2,1:2
 refused "view of a 2D run" "3D runs only" run --view +x
 refused "unknown view" "--view 'up'" run --view up
 refused "unknown geometry" "--geometry 'round'" run --geometry round

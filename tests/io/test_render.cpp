@@ -654,6 +654,41 @@ TEST(Render, BadOptionsFailNamingWhatIsWrong) {
                          "no snapshot 5"));
 }
 
+TEST(Render, ARegionDrawsOnlyItsWindowAndTakesTheColourRangeFromIt) {
+    const LoadedSnapshot s = snapshot_of("region", three_nodes());
+    RenderOptions o;
+    o.field = "pressure";
+    o.width = 400;
+    o.height = 400;
+    // A window around A and C only (x 0.5 to 2.5 mm, z 0.5 to 3.5 mm): B (x = 3 mm, reaching
+    // 2.75 mm) is left out, so the range is A's and C's (0 to 5 Pa) and C takes the top colour.
+    o.region = std::array<double, 4>{0.5e-3, 2.5e-3, 0.5e-3, 3.5e-3};
+    const Picture p = render_snapshot(s, GeometryKind::PlaneStrain, o);
+    EXPECT_EQ(p.discs, 2u);
+    EXPECT_EQ(p.range_min, 0.0);
+    EXPECT_EQ(p.range_max, 5.0);
+    EXPECT_EQ(pixel_at(p, 1e-3, 1e-3), colour_map(0.0));
+    EXPECT_EQ(pixel_at(p, 2e-3, 3e-3), colour_map(1.0));
+    // The window fills the plot: its corners are on the image, 2 mm high in ~all of the plot's height.
+    const auto [x_left, y_top] = p.frame.pixel(0.5e-3, 3.5e-3);
+    const auto [x_right, y_bottom] = p.frame.pixel(2.5e-3, 0.5e-3);
+    EXPECT_GE(x_left, 0.0);
+    EXPECT_LE(x_right, 400.0);
+    EXPECT_GE(y_top, 0.0);
+    EXPECT_LE(y_bottom, 400.0);
+    EXPECT_GT(x_right - x_left, 100.0);
+    // A disc reaching into the window from outside it is drawn: B's edge is at 2.75 mm.
+    o.region = std::array<double, 4>{2.6e-3, 4e-3, 0.0, 2e-3};
+    EXPECT_EQ(render_snapshot(s, GeometryKind::PlaneStrain, o).discs, 1u);
+    // Nothing in the window, or a window the wrong way round: an error naming it.
+    o.region = std::array<double, 4>{10e-3, 20e-3, 0.0, 1e-3};
+    std::string e = error_of([&] { render_snapshot(s, GeometryKind::PlaneStrain, o); });
+    EXPECT_TRUE(contains(e, "nothing to draw in the region") && contains(e, "spans")) << e;
+    o.region = std::array<double, 4>{2e-3, 1e-3, 0.0, 1e-3};
+    e = error_of([&] { render_snapshot(s, GeometryKind::PlaneStrain, o); });
+    EXPECT_TRUE(contains(e, "must end above")) << e;
+}
+
 TEST(Render, NotFiniteValuesAreMarkedAndLeftOutOfTheRange) {
     NodeStore n = three_nodes();
     n.pressure[2] = std::nan("");

@@ -87,6 +87,10 @@ struct RenderOptions {
     std::optional<double> range_min, range_max;
     std::optional<bool> mirror;                       // 2D: mirror about x = 0; default: axisymmetric
     std::optional<ViewDirection> view;                // 3D only; default +y
+    // Only this window of the picture plane, {left, right, bottom, top} in metres along the
+    // picture's own axes (2D: x and z; 3D: the view's right and up); the colour range and the
+    // counts then cover only what lies in it. Default: the whole snapshot.
+    std::optional<std::array<double, 4>> region;
     std::string title;                                // drawn at the top (e.g. the run's name)
 };
 inline constexpr int min_width = 200, min_height = 150, max_side = 8192;
