@@ -336,7 +336,8 @@ int run_study(const StudyOptions& options) {
         for (const auto& c : report.cases) {
             if (c.finished && (!finest || c.cell_size < finest->cell_size)) finest = &c;
         }
-        const auto ref = io::reference_from_study(report, analysis, series_names.front(), finest ? finest->outline : decltype(finest->outline){});
+        auto ref = io::reference_from_study(report, analysis, series_names.front(), finest ? finest->outline : decltype(finest->outline){});
+        ref.peak_radius = scene.output.peak_radius;
         io::write_element_reference(*options.reference, ref);
         fmt::print("element reference: {} ({} metrics{})\n", options.reference->string(), ref.values.size(),
                    ref.missing.empty() ? "" : fmt::format(", {} without a reference", ref.missing.size()));

@@ -244,6 +244,12 @@ TEST(ElementReference, OutlineDistanceAndRatios) {
     EXPECT_DOUBLE_EQ(r.at("plastic_work"), 1.02);
     EXPECT_FALSE(r.count("footprint_diameter"));  // the reference has none
     EXPECT_NEAR(r.at("outline_distance"), 0.5, 1e-12);
+    // Peaks compare only over the same neighbourhood.
+    ref.values["peak_plastic_strain"].value = 2.0;
+    ref.peak_radius = 0.5e-3;
+    EXPECT_DOUBLE_EQ(io::compare_with_reference({{"peak_plastic_strain", 1.8}, {"peak_radius", 0.5e-3}}, a, ref).at("peak_plastic_strain"), 0.9);
+    EXPECT_FALSE(io::compare_with_reference({{"peak_plastic_strain", 1.8}, {"peak_radius", 0.7e-3}}, a, ref).count("peak_plastic_strain"));
+    EXPECT_FALSE(io::compare_with_reference({{"peak_plastic_strain", 1.8}}, a, ref).count("peak_plastic_strain"));
 }
 
 }  // namespace

@@ -126,6 +126,7 @@ int main(int argc, char** argv) {
         // The commit of the program that made the runs (GPA_RUNS_COMMIT), not this tool's.
         if (const char* c = std::getenv("GPA_RUNS_COMMIT")) ref.commit = c;
         ref.written_by = "gpa_reference_from_runs from the gpa run folders of its cases (tools/reference_from_runs.cpp)";
+        ref.peak_radius = scene.output.peak_radius;
         io::write_element_reference(argv[2], ref);
         for (const auto& [key, x] : ref.values) {
             fmt::print("  {}: {:.6g} ({}, {}, order {:.2f}, uncertainty {:.3g})\n", key, x.value, x.kind, x.status, x.order, x.uncertainty);

@@ -314,6 +314,7 @@ std::map<std::string, double> run_metrics(const Simulation& sim) {
     if (t.local.measured && t.local.plastic_strain.points > 0) {
         m["peak_plastic_strain"] = t.local.plastic_strain.value;
         m["peak_temperature"] = t.local.temperature.value;
+        m["peak_radius"] = t.local.radius;
     }
     return m;
 }

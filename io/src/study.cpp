@@ -518,6 +518,7 @@ std::map<std::string, double> RunProbe::metrics(const Simulation& sim) const {
     if (t.local.measured && t.local.plastic_strain.points > 0) {
         m["peak_plastic_strain"] = t.local.plastic_strain.value;
         m["peak_temperature"] = t.local.temperature.value;
+        m["peak_radius"] = t.local.radius;  // not a study metric: tells the reference comparison the neighbourhood
         if (t.local.face_points >= 3) m["face_roughness"] = t.local.face_roughness;
     }
     if (plane_ < 0) return m;

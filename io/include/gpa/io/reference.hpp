@@ -45,6 +45,7 @@ struct ElementReference {
     std::string scene_file;                     // as given to the study
     std::string variant;                        // the element variant, as typed
     std::vector<double> cell_sizes;             // m, coarse to fine
+    double peak_radius = 0.0;                   // m: the neighbourhood of its peaks (0: not recorded)
     std::string date;                           // UTC, YYYY-MM-DD
     std::string commit;                         // source_commit() of the program that ran the cases
     std::string written_by = "gpa study --reference";  // what assembled the file
@@ -76,7 +77,9 @@ std::vector<std::pair<double, double>> final_outline(const Simulation& sim);
 double outline_distance(const std::vector<std::pair<double, double>>& a, const std::vector<std::pair<double, double>>& b);
 
 // Ratios of a run to the reference (the paper's L*, D*, PW* and the peaks): value / reference
-// for each metric both have; and "outline_distance" (m) when both have outlines.
+// for each metric both have; and "outline_distance" (m) when both have outlines. The peaks are
+// compared only when `metrics` holds "peak_radius" equal to the reference's (a peak over another
+// neighbourhood is another quantity).
 std::map<std::string, double> compare_with_reference(const std::map<std::string, double>& metrics,
                                                      const std::vector<std::pair<double, double>>& outline,
                                                      const ElementReference& reference);
