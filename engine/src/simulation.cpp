@@ -1345,7 +1345,7 @@ void Simulation::Impl::measure_local_fields() {
                     const double hc = plane->distance(m.nodes.position[plane->axis][c]) - totals.base_height;
                     if (hb <= tol && hc <= tol) {
                         face_across.push_back(p.position[across]);
-                        face_value.push_back(p.value);
+                        face_value.push_back(m.points.plastic_strain[t]);
                     }
                 }
             }
