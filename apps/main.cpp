@@ -2,6 +2,7 @@
 //   gpa run [SCENE] [-o DIR] [--threads N] [--overwrite] [--quiet] [--max-memory SIZE]
 //   gpa run --resume DIR [--threads N] [--quiet] [--max-memory SIZE]
 //   gpa study SCENE [-o DIR] [--refine 1,1.5,2] [--variant NAME:key=value,...]... [--threads 1,2] [--overwrite] [-q]
+//             [--reference FILE]
 //   gpa check SCENE [--max-memory SIZE]
 //   gpa render RUN_DIR [--field NAME[:x|y|z]] [-o PNG] [--snapshot N|last | --time T] [--size WxH | --width W]
 //              [--range MIN:MAX] [--mirror | --no-mirror] [--view +y] [--geometry G] [--list] [-q]
@@ -135,6 +136,10 @@ int main(int argc, char** argv) {
         ->take_all();
     study->add_option("--threads", study_options.threads, "thread counts, e.g. 1,2 (0 = all hardware threads; default 0)");
     study->add_flag("--overwrite", study_options.overwrite, "replace an existing output folder when the study ends");
+    std::string study_reference;
+    study->add_option("--reference", study_reference,
+                      "write the study's series (one series, three or more resolutions) as the scene's element reference "
+                      "FILE (docs/validation.md, \"Element references\")");
     study->add_flag("-q,--quiet", study_options.quiet, "no progress and no summary, only where the output went");
     study->add_option("--max-memory", memory_text, memory_help)->check(memory_check);
 
@@ -218,6 +223,7 @@ int main(int argc, char** argv) {
         if (study->parsed()) {
             study_options.scene = study_scene;
             if (!study_output.empty()) study_options.output = study_output;
+            if (!study_reference.empty()) study_options.reference = study_reference;
             study_options.memory = memory;
             return gpa::app::run_study(study_options);
         }

@@ -24,6 +24,7 @@
 #include "gpa/io/checkpoint.hpp"
 #include "gpa/io/material_library.hpp"
 #include "gpa/io/output.hpp"
+#include "gpa/io/reference.hpp"
 #include "gpa/io/scene_file.hpp"
 #include "progress.hpp"
 #include "signals.hpp"
@@ -241,6 +242,30 @@ void print_report(const Simulation& sim) {
     for (const auto& c : io::compare_with_reference(sim)) {
         fmt::print("  {}: {:.4g} against the reference {:.4g} ({:+.2f} %)\n", c.key, c.computed, c.reference,
                    100.0 * c.relative_error);
+    }
+    if (t.local.measured && t.local.plastic_strain.points > 0) {
+        fmt::print("  peak plastic strain {:.4g} (mean within {:.3g} mm) at ({:.3g}, {:.3g}) mm, largest single value {:.4g}; "
+                   "peak temperature {:.4g} K\n",
+                   t.local.plastic_strain.value, t.local.radius * 1e3, t.local.plastic_strain.position[0] * 1e3,
+                   t.local.plastic_strain.position[dim - 1] * 1e3, t.local.plastic_strain.raw, t.local.temperature.value);
+    }
+    if (!sim.scene().element_reference.empty()) {
+        try {
+            const auto ref = io::read_element_reference(sim.scene().element_reference);
+            const auto ratios = io::compare_with_reference(io::run_metrics(sim), io::final_outline(sim), ref);
+            std::string line;
+            for (const auto& [key, label] : std::vector<std::pair<std::string, std::string>>{
+                     {"final_length", "L*"}, {"footprint_diameter", "D*"}, {"plastic_work", "PW*"},
+                     {"peak_plastic_strain", "peak strain*"}, {"peak_temperature", "peak T*"}}) {
+                if (const auto it = ratios.find(key); it != ratios.end()) line += fmt::format("{}{} {:.4f}", line.empty() ? "" : ", ", label, it->second);
+            }
+            if (const auto it = ratios.find("outline_distance"); it != ratios.end()) {
+                line += fmt::format(", outline distance {:.3g} mm", it->second * 1e3);
+            }
+            fmt::print("  against the element reference ({}): {}\n", sim.scene().element_reference, line);
+        } catch (const InputError& e) {
+            fmt::print("  element reference: {}\n", e.what());
+        }
     }
 }
 

@@ -22,6 +22,7 @@
 #include "gpa/engine/parallel.hpp"
 #include "gpa/engine/simulation.hpp"
 #include "gpa/io/output.hpp"
+#include "gpa/io/reference.hpp"
 #include "gpa/io/scene_file.hpp"
 #include "gpa/io/study.hpp"
 #include "progress.hpp"
@@ -225,6 +226,18 @@ int run_study(const StudyOptions& options) {
         }
     }
 
+    if (options.reference) {
+        if (series_names.size() != 1) {
+            throw InputError(fmt::format("--reference: the study has {} series; a reference is written from one (one variant, "
+                                         "one thread count)",
+                                         series_names.size()));
+        }
+        if (factors.size() < 3) throw InputError("--reference: a reference needs three or more resolutions (--refine)");
+        const fs::path parent = options.reference->parent_path();
+        if (!parent.empty() && !fs::is_directory(parent)) {
+            throw InputError(fmt::format("--reference {}: the folder {} does not exist", options.reference->string(), parent.string()));
+        }
+    }
     const fs::path output = options.output.value_or(default_output_folder("studies", scene.name));
     io::RunFolder folder(output, options.overwrite);
     io::StudyReport report;
@@ -235,6 +248,7 @@ int run_study(const StudyOptions& options) {
     report.variants = variants;
     report.reference = scene.reference;
     report.reference_source = scene.reference_source;
+    if (!scene.element_reference.empty()) report.element_reference = io::read_element_reference(scene.element_reference);
     MemoryGauge memory;
     report.memory_note = memory.note();
     if (!options.quiet) {
@@ -287,7 +301,9 @@ int run_study(const StudyOptions& options) {
             progress.finish(*sim);
             c.finished = true;
             c.message = sim->stop_reason();
+            sim->measure_bodies();  // the local peaks (and the bodies' pieces) of the final state
             c.metrics = probe.metrics(*sim);
+            c.outline = io::final_outline(*sim);
         } catch (const std::exception& e) {
             c.finished = false;
             c.message = e.what();
@@ -314,6 +330,18 @@ int run_study(const StudyOptions& options) {
     const auto analysis = io::analyse_study(report);
     const auto plots = io::write_study_plots(folder.partial(), report, analysis);
     folder.commit();
+    if (options.reference) {
+        // The finest finished case's outline goes with the reference.
+        const io::StudyCase* finest = nullptr;
+        for (const auto& c : report.cases) {
+            if (c.finished && (!finest || c.cell_size < finest->cell_size)) finest = &c;
+        }
+        auto ref = io::reference_from_study(report, analysis, series_names.front(), finest ? finest->outline : decltype(finest->outline){});
+        ref.peak_radius = scene.output.peak_radius;
+        io::write_element_reference(*options.reference, ref);
+        fmt::print("element reference: {} ({} metrics{})\n", options.reference->string(), ref.values.size(),
+                   ref.missing.empty() ? "" : fmt::format(", {} without a reference", ref.missing.size()));
+    }
     if (!options.quiet) print_summary(report, analysis);
     std::string files = "study.md, study.csv";
     for (const auto& p : plots) files += fmt::format(", {}", p.filename().string());

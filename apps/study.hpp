@@ -20,6 +20,9 @@ struct StudyOptions {
     bool overwrite = false;
     bool quiet = false;
     MemoryLimit memory;  // --max-memory, for every case
+    // --reference FILE: write the series as the scene's element reference (io/reference.hpp); the
+    // study must have one series and three or more resolutions.
+    std::optional<std::filesystem::path> reference;
 };
 
 // Runs the study; returns the process exit code (0, or 3 when a case failed; the outputs are

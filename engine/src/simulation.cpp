@@ -187,7 +187,9 @@ struct Simulation::Impl {
     void advance_region_displacements(double dt);
     void sum_totals();
     void sum_body_totals(bool advance_kinetic, const Sums* particle_sums = nullptr);
-    measure::Extent element_extent(const GhostPlane& plane, bool axisymmetric) const;
+    measure::Extent element_extent(const GhostPlane& plane, bool axisymmetric, double base = 0.0) const;
+    measure::Extent particle_extent(const GhostPlane& plane, bool axisymmetric, double base) const;
+    void measure_local_fields();
     void regroup_materials();
 };
 
@@ -372,12 +374,14 @@ void Simulation::Impl::move() {
 
 template <class G>
 void Simulation::Impl::geometry() {
-    // Node diameters (Eq. 3) and size weights (Eq. 4) at the new positions, with the volumes of
-    // the previous stress update; the gradient and the next forces both use these.
+    // Node diameters (Eq. 3, or the volume rule of the solver's node_diameter) and size weights
+    // (Eq. 4) at the new positions, with the volumes of the previous stress update; the gradient
+    // and the next forces both use these.
+    const int diameter_rule = scene.solver.node_diameter == NodeDiameter::Section ? 0 : scene.solver.node_diameter == NodeDiameter::Volume ? 1 : 2;
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, real, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
         for (std::size_t i = r.begin(); i != r.end(); ++i) {
             nodes.diameter[i] = node_diameter<G>(nodes.initial_diameter[i], nodes.volumetric_strain[i],
-                                                 nodes.initial_position[0][i], nodes.position[0][i]);
+                                                 nodes.initial_position[0][i], nodes.position[0][i], diameter_rule);
         }
         update_size_weights(nodes, r.begin(), r.end());
     });
@@ -1023,7 +1027,8 @@ void Simulation::Impl::sum_totals() {
                     // Width across the plane's first other axis (radius x in axisymmetric geometry).
                     const int across = plane->axis == 0 ? 1 : 0;
                     measure::add_particle(acc.extent, plane->distance(nodes.position[plane->axis][i]),
-                                          nodes.position[across][i], nodes.diameter[i], axisymmetric && across == 0);
+                                          nodes.position[across][i], measure::particle_cell_size(nodes.size_weight[i], d),
+                                          axisymmetric && across == 0);
                 }
             }
             return acc;
@@ -1077,8 +1082,17 @@ void Simulation::Impl::sum_totals() {
     totals.time = time;
     totals.time_step = dt_half;
     totals.step = steps;
-    totals.length = plane ? all.extent.length() : 0.0;
-    totals.footprint_diameter = plane ? all.extent.footprint() : 0.0;
+    // The base the body is measured from (measure.hpp): the plane while it stands on it, which the
+    // pass above measured; otherwise its own underside, measured in a second pass.
+    measure::Extent shape = all.extent;
+    totals.base_height = 0.0;
+    if (plane && shape.seen() && !shape.standing()) {
+        totals.base_height = shape.lowest;
+        shape = particle_extent(*plane, axisymmetric, totals.base_height);
+        if (elements) shape += element_extent(*plane, axisymmetric, totals.base_height);
+    }
+    totals.length = plane ? shape.length() : 0.0;
+    totals.footprint_diameter = plane ? shape.footprint() : 0.0;
     totals.real_nodes = real;
     totals.element_nodes = elements ? elements->mesh().nodes.size() : 0;
     totals.elements = elements ? elements->mesh().quads.size() : 0;
@@ -1106,7 +1120,21 @@ void Simulation::Impl::sum_totals() {
     }
 }
 
-measure::Extent Simulation::Impl::element_extent(const GhostPlane& plane, bool axisymmetric) const {
+measure::Extent Simulation::Impl::particle_extent(const GhostPlane& plane, bool axisymmetric, double base) const {
+    const int across = plane.axis == 0 ? 1 : 0;
+    return tbb::parallel_deterministic_reduce(
+        tbb::blocked_range<std::size_t>(0, real, reduce_grain), measure::Extent{},
+        [&](const tbb::blocked_range<std::size_t>& r, measure::Extent acc) {
+            for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                measure::add_particle(acc, plane.distance(nodes.position[plane.axis][i]) - base, nodes.position[across][i],
+                                      measure::particle_cell_size(nodes.size_weight[i], dim()), axisymmetric && across == 0);
+            }
+            return acc;
+        },
+        [](measure::Extent x, const measure::Extent& y) { return x += y; });
+}
+
+measure::Extent Simulation::Impl::element_extent(const GhostPlane& plane, bool axisymmetric, double base) const {
     // The element rule of measure.hpp: nodes lie on the boundary (no d/2), "on the plane" within
     // the face tolerance of the node's body.
     const ElementMesh& m = elements->mesh();
@@ -1116,7 +1144,7 @@ measure::Extent Simulation::Impl::element_extent(const GhostPlane& plane, bool a
         [&](const tbb::blocked_range<std::size_t>& r, measure::Extent acc) {
             for (std::size_t i = r.begin(); i != r.end(); ++i) {
                 const double spacing = m.body_spacing[static_cast<std::size_t>(m.nodes.body[i])];
-                measure::add_element_node(acc, plane.distance(m.nodes.position[plane.axis][i]), m.nodes.position[across][i],
+                measure::add_element_node(acc, plane.distance(m.nodes.position[plane.axis][i]) - base, m.nodes.position[across][i],
                                           measure::element_face_tolerance(spacing), axisymmetric && across == 0);
             }
             return acc;
@@ -1252,8 +1280,81 @@ const NodeStore& Simulation::nodes() const { return impl_->nodes; }
 std::size_t Simulation::real_count() const { return impl_->real; }
 const Totals& Simulation::totals() const { return impl_->totals; }
 void Simulation::measure_bodies() {
+    impl_->measure_local_fields();
     if (!impl_->particles) return;
     gpa::measure_bodies(impl_->nodes, impl_->real, impl_->lists, impl_->impact, impl_->totals.bodies);
+}
+
+void Simulation::Impl::measure_local_fields() {
+    // measure.hpp: peaks over a neighbourhood of the same radius for particle nodes and element
+    // triangles; the face roughness over the points on the body's base.
+    auto& out = totals.local;
+    out.radius = scene.output.peak_radius > 0.0 ? scene.output.peak_radius
+                 : scene.bodies.empty()        ? 0.0
+                                               : 2.0 * scene.bodies.front().spacing;
+    out.measured = out.radius > 0.0;
+    if (!out.measured) return;
+    const int d = dim();
+    const GhostPlane* plane = rigid_planes.empty() ? nullptr : &ghosts.planes()[rigid_planes.front()];
+    const int across = plane && plane->axis == 0 ? 1 : 0;
+    std::vector<measure::FieldPoint> strain, heat;
+    std::vector<double> face_across, face_value;
+    // The face row of particles: nodes on the base now that started in the lattice row nearest
+    // the plane (below the next row up), so that a second row pressed down does not mix in.
+    double first_row = INFINITY;
+    if (plane) {
+        for (std::size_t i = 0; i < real; ++i) first_row = std::min(first_row, plane->distance(nodes.initial_position[plane->axis][i]));
+    }
+    for (std::size_t i = 0; i < real; ++i) {
+        measure::FieldPoint p;
+        for (int c = 0; c < d; ++c) p.position[c] = nodes.position[c][i];
+        p.weight = nodes.size_weight[i];
+        p.body = nodes.body[i];
+        p.value = nodes.plastic_strain[i];
+        strain.push_back(p);
+        p.value = nodes.temperature[i];
+        heat.push_back(p);
+        if (plane && plane->distance(nodes.position[plane->axis][i]) - totals.base_height < measure::particle_cell_size(nodes.size_weight[i], d) &&
+            plane->distance(nodes.initial_position[plane->axis][i]) - first_row < 0.5 * nodes.initial_diameter[i]) {
+            face_across.push_back(nodes.position[across][i]);
+            face_value.push_back(nodes.plastic_strain[i]);
+        }
+    }
+    if (elements) {
+        const ElementMesh& m = elements->mesh();
+        for (std::size_t q = 0; q < m.quads.size(); ++q) {
+            const auto& n = m.quads.nodes[q];
+            for (int k = 0; k < 4; ++k) {
+                const NodeIndex a = n[4], b = n[k], c = n[(k + 1) % 4];
+                const std::size_t t = 4 * q + static_cast<std::size_t>(k);
+                measure::FieldPoint p;
+                for (int x = 0; x < 2; ++x) {
+                    p.position[x] = (m.nodes.position[x][a] + m.nodes.position[x][b] + m.nodes.position[x][c]) / 3.0;
+                }
+                p.weight = 0.5 * std::abs((m.nodes.position[0][b] - m.nodes.position[0][a]) * (m.nodes.position[1][c] - m.nodes.position[1][a]) -
+                                          (m.nodes.position[1][b] - m.nodes.position[1][a]) * (m.nodes.position[0][c] - m.nodes.position[0][a]));
+                p.body = m.quads.body[q];
+                p.value = m.points.plastic_strain[t];
+                strain.push_back(p);
+                p.value = m.points.temperature[t];
+                heat.push_back(p);
+                if (plane) {
+                    // A triangle whose outer edge lies on the base.
+                    const double tol = measure::element_face_tolerance(m.body_spacing[static_cast<std::size_t>(m.quads.body[q])]);
+                    const double hb = plane->distance(m.nodes.position[plane->axis][b]) - totals.base_height;
+                    const double hc = plane->distance(m.nodes.position[plane->axis][c]) - totals.base_height;
+                    if (hb <= tol && hc <= tol) {
+                        face_across.push_back(p.position[across]);
+                        face_value.push_back(m.points.plastic_strain[t]);
+                    }
+                }
+            }
+        }
+    }
+    out.plastic_strain = measure::local_peak(strain, out.radius, d);
+    out.temperature = measure::local_peak(heat, out.radius, d);
+    out.face_roughness = measure::face_roughness(face_across, face_value);
+    out.face_points = face_value.size();
 }
 double Simulation::time() const { return impl_->time; }
 std::size_t Simulation::steps() const { return impl_->steps; }

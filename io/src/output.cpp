@@ -1,4 +1,5 @@
 #include "gpa/io/output.hpp"
+#include "gpa/io/reference.hpp"
 
 #include <algorithm>
 #include <cerrno>
@@ -105,7 +106,18 @@ std::string history_header(const Totals& first, int dim) {
         "time_s,dt_s,step,kinetic_energy_J,internal_energy_J,plastic_work_J,viscous_work_J,boundary_work_J,"
         "total_energy_error,hourglass_work_J";
     header += dim == 3 ? ",momentum_x_kg_m_s,momentum_y_kg_m_s,momentum_z_kg_m_s" : ",momentum_x_kg_m_s,momentum_z_kg_m_s";
-    header += ",length_m,footprint_diameter_m";
+    header += ",length_m,footprint_diameter_m,base_height_m";
+    // Local peaks (measure.hpp): the neighbourhood peak, where it is, the largest single value.
+    const char* axes = dim == 3 ? "xyz" : "xz";
+    for (const char* field : {"plastic_strain", "temperature_K"}) {
+        const std::string name = field;
+        const std::string stem = name.substr(0, name.find("_K"));
+        const std::string unit = name.size() > stem.size() ? "_K" : "";
+        header += fmt::format(",peak_{}{}", stem, unit);
+        for (int c = 0; c < dim; ++c) header += fmt::format(",peak_{}_{}_m", stem, axes[c]);
+        header += fmt::format(",max_{}{}", stem, unit);
+    }
+    header += ",face_plastic_strain_roughness";
     for (const auto& p : first.planes) header += fmt::format(",{0}_reaction_N,{0}_impulse_N_s", p.name.empty() ? "plane" : p.name);
     for (const auto& r : first.regions) {
         const std::string name = r.name.empty() ? "region" : r.name;
@@ -183,7 +195,13 @@ void HistoryWriter::write(const Totals& t) {
                                   t.step, t.kinetic_energy, t.internal_energy, t.plastic_work, t.viscous_work,
                                   t.boundary_work, t.energy_error, t.hourglass_work);
     for (int c = 0; c < dim_; ++c) row += fmt::format(",{:.9e}", t.momentum[c]);
-    row += fmt::format(",{:.9e},{:.9e}", t.length, t.footprint_diameter);
+    row += fmt::format(",{:.9e},{:.9e},{:.9e}", t.length, t.footprint_diameter, t.base_height);
+    for (const auto* peak : {&t.local.plastic_strain, &t.local.temperature}) {
+        row += fmt::format(",{:.9e}", peak->value);
+        for (int c = 0; c < dim_; ++c) row += fmt::format(",{:.9e}", peak->position[c]);
+        row += fmt::format(",{:.9e}", peak->raw);
+    }
+    row += fmt::format(",{:.9e}", t.local.face_roughness);
     for (std::size_t p = 0; p < planes_; ++p) {
         const PlaneReport r = p < t.planes.size() ? t.planes[p] : PlaneReport{};
         row += fmt::format(",{:.9e},{:.9e}", r.reaction, r.impulse);
@@ -289,11 +307,47 @@ std::string json_number(double v) { return std::isfinite(v) ? fmt::format("{:.10
 
 }  // namespace
 
+std::map<std::string, double> run_metrics(const Simulation& sim) {
+    const auto& t = sim.totals();
+    std::map<std::string, double> m{{"final_length", t.length}, {"footprint_diameter", t.footprint_diameter},
+                                    {"plastic_work", t.plastic_work}};
+    if (t.local.measured && t.local.plastic_strain.points > 0) {
+        m["peak_plastic_strain"] = t.local.plastic_strain.value;
+        m["peak_temperature"] = t.local.temperature.value;
+        m["peak_radius"] = t.local.radius;
+    }
+    return m;
+}
+
+std::string element_reference_json(const Simulation& sim) {
+    const Scene& scene = sim.scene();
+    if (scene.element_reference.empty()) return {};
+    ElementReference ref;
+    try {
+        ref = read_element_reference(scene.element_reference);
+    } catch (const InputError& e) {
+        return fmt::format("{{\"file\": {}, \"error\": {}}}", json_string(scene.element_reference), json_string(e.what()));
+    }
+    const auto metrics = run_metrics(sim);
+    const auto ratios = compare_with_reference(metrics, final_outline(sim), ref);
+    std::string values;
+    for (const auto& [key, v] : ref.values) {
+        const auto m = metrics.find(key);
+        const auto r = ratios.find(key);
+        values += fmt::format("{}{}: {{\"reference\": {}, \"kind\": {}, \"uncertainty\": {}, \"computed\": {}, \"ratio\": {}}}",
+                              values.empty() ? "" : ", ", json_string(key), json_number(v.value), json_string(v.kind),
+                              json_number(v.uncertainty), json_number(m != metrics.end() ? m->second : NAN),
+                              json_number(r != ratios.end() ? r->second : NAN));
+    }
+    const auto d = ratios.find("outline_distance");
+    return fmt::format("{{\"file\": {}, \"commit\": {}, \"date\": {}, \"values\": {{{}}}, \"outline_distance_m\": {}}}",
+                       json_string(scene.element_reference), json_string(ref.commit), json_string(ref.date), values,
+                       json_number(d != ratios.end() ? d->second : NAN));
+}
+
 std::vector<ReferenceComparison> compare_with_reference(const Simulation& sim) {
     std::vector<ReferenceComparison> out;
-    const auto& t = sim.totals();
-    const std::map<std::string, double> computed{
-        {"final_length", t.length}, {"footprint_diameter", t.footprint_diameter}, {"plastic_work", t.plastic_work}};
+    const std::map<std::string, double> computed = run_metrics(sim);
     for (const auto& [key, value] : sim.scene().reference) {
         const auto it = computed.find(key);
         if (it == computed.end()) continue;
@@ -324,8 +378,25 @@ void write_summary(const fs::path& file, const Simulation& sim, const RunSummary
     field("element_nodes", std::to_string(t.element_nodes));
     field("elements", std::to_string(t.elements));
     field("threads", std::to_string(sim.threads()));
-    field("final", fmt::format("{{\"length_m\": {}, \"footprint_diameter_m\": {}, \"plastic_work_J\": {}}}",
-                               json_number(t.length), json_number(t.footprint_diameter), json_number(t.plastic_work)));
+    field("final", fmt::format("{{\"length_m\": {}, \"footprint_diameter_m\": {}, \"base_height_m\": {}, \"plastic_work_J\": {}}}",
+                               json_number(t.length), json_number(t.footprint_diameter), json_number(t.base_height),
+                               json_number(t.plastic_work)));
+    {
+        // Local peaks (measure.hpp): the mean over a neighbourhood of `radius_m`, where it is
+        // centred, and the largest value at one material point.
+        const auto peak = [&](const measure::LocalPeak& p) {
+            std::string at = "[";
+            for (int c = 0; c < dimension_of(scene.geometry); ++c) at += (c ? ", " : "") + json_number(p.position[c]);
+            std::string raw_at = "[";
+            for (int c = 0; c < dimension_of(scene.geometry); ++c) raw_at += (c ? ", " : "") + json_number(p.raw_position[c]);
+            return fmt::format("{{\"peak\": {}, \"at_m\": {}], \"max\": {}, \"max_at_m\": {}]}}", json_number(p.value), at,
+                               json_number(p.raw), raw_at);
+        };
+        field("local", fmt::format("{{\"radius_m\": {}, \"plastic_strain\": {}, \"temperature_K\": {}, "
+                                   "\"face_plastic_strain_roughness\": {}, \"face_points\": {}}}",
+                                   json_number(t.local.radius), peak(t.local.plastic_strain), peak(t.local.temperature),
+                                   json_number(t.local.face_roughness), t.local.face_points));
+    }
     field("energy", fmt::format("{{\"initial_J\": {}, \"kinetic_J\": {}, \"internal_J\": {}, \"plastic_work_J\": {}, "
                                 "\"viscous_work_J\": {}, \"hourglass_work_J\": {}, \"boundary_work_J\": {}, \"given_J\": {}, \"relative_error\": {}}}",
                                 json_number(t.initial_energy), json_number(t.kinetic_energy), json_number(t.internal_energy),
@@ -390,6 +461,9 @@ void write_summary(const fs::path& file, const Simulation& sim, const RunSummary
     }
     field("reference", refs + "]");
     field("reference_source", json_string(scene.reference_source));
+    // The element reference of the scene ([reference] elements; io/reference.hpp): the paper's
+    // L*, D*, PW* and the peaks as ratios, the outline distance.
+    if (const std::string e = element_reference_json(sim); !e.empty()) field("element_reference", e);
     std::string phases = "{";
     double stepping = 0.0;
     const auto times = sim.phase_times();
@@ -440,16 +514,19 @@ std::vector<std::pair<double, double>> element_outline(const ElementMesh& m, con
 
 }  // namespace
 
-void write_profile(const fs::path& file, const Simulation& sim) {
+std::vector<std::pair<double, double>> final_outline(const Simulation& sim) {
     const Scene& scene = sim.scene();
     const auto plane = std::find_if(scene.planes.begin(), scene.planes.end(),
                                     [](const PlaneSpec& p) { return p.kind == PlaneKind::Rigid; });
-    if (plane == scene.planes.end()) return;
+    std::vector<std::pair<double, double>> out;
+    if (plane == scene.planes.end()) return out;
     const NodeStore& n = sim.nodes();
     const std::size_t count = sim.real_count();
     const ElementPart* elements = sim.elements();
-    if (count == 0 && !elements) return;
+    if (count == 0 && !elements) return out;
     const int dim = n.dim();
+    // Heights from the body's base (measure.hpp): the plane while it stands on it, else its underside.
+    const double base = sim.totals().base_height;
     // The horizontal axes: those other than the plane's normal.
     std::vector<int> across;
     for (int c = 0; c < dim; ++c) {
@@ -459,7 +536,6 @@ void write_profile(const fs::path& file, const Simulation& sim) {
     // centroid.
     const bool axisymmetric = scene.geometry == GeometryKind::Axisymmetric && plane->axis == 1;
     std::array<double, 3> centre{0, 0, 0};
-    std::string text = "height_m,radius_m\n";
     if (elements) {
         // Element bodies are 2D: one axis across the plane.
         const ElementMesh& m = elements->mesh();
@@ -467,13 +543,12 @@ void write_profile(const fs::path& file, const Simulation& sim) {
             for (std::size_t i = 0; i < m.nodes.size(); ++i) centre[across[0]] += m.nodes.position[across[0]][i] / double(m.nodes.size());
         }
         double top = 0.0;
-        for (const auto& [h, r] : element_outline(m, *plane, across[0], centre[across[0]], axisymmetric)) {
-            text += fmt::format("{:.6e},{:.6e}\n", h, r);
-            top = std::max(top, h);
+        for (auto [h, r] : element_outline(m, *plane, across[0], centre[across[0]], axisymmetric)) {
+            out.emplace_back(h - base, r);
+            top = std::max(top, h - base);
         }
-        text += fmt::format("{:.6e},{:.6e}\n", top, 0.0);
-        write_text_file(file, text);
-        return;
+        out.emplace_back(top, 0.0);
+        return out;
     }
     if (!axisymmetric) {
         for (std::size_t i = 0; i < count; ++i) {
@@ -483,25 +558,34 @@ void write_profile(const fs::path& file, const Simulation& sim) {
     double mean_d = 0.0;
     measure::Extent extent;
     for (std::size_t i = 0; i < count; ++i) {
-        mean_d += n.diameter[i] / double(count);
-        measure::add_particle(extent, plane->side * (n.position[plane->axis][i] - plane->position), 0.0, n.diameter[i], false);
+        const double cell = measure::particle_cell_size(n.size_weight[i], dim);
+        mean_d += cell / double(count);
+        measure::add_particle(extent, plane->side * (n.position[plane->axis][i] - plane->position) - base, 0.0, cell, false);
     }
     const double top = std::max(extent.length(), 0.0);
     const double bin = mean_d;  // one row of nodes: narrower bins hold only inner nodes every other time
     // Only the bins that hold nodes, at most one per node, however far apart the bodies are.
     std::map<double, double> radius;  // bin index (a whole number) -> largest extent
     for (std::size_t i = 0; i < count; ++i) {
-        const double h = plane->side * (n.position[plane->axis][i] - plane->position);
+        const double h = plane->side * (n.position[plane->axis][i] - plane->position) - base;
         double r = 0.0;
         for (int c : across) r += (n.position[c][i] - centre[c]) * (n.position[c][i] - centre[c]);
         r = std::sqrt(r);
         const double k = std::floor(std::max(h / bin, 0.0));
-        const double extent_r = measure::particle_outline_radius(r, n.diameter[i]);
+        const double extent_r = measure::particle_outline_radius(r, measure::particle_cell_size(n.size_weight[i], dim));
         const auto [it, added] = radius.try_emplace(k, extent_r);
         if (!added) it->second = std::max(it->second, extent_r);
     }
-    for (const auto& [k, r] : radius) text += fmt::format("{:.6e},{:.6e}\n", (k + 0.5) * bin, r);
-    text += fmt::format("{:.6e},{:.6e}\n", top, 0.0);
+    for (const auto& [k, r] : radius) out.emplace_back((k + 0.5) * bin, r);
+    out.emplace_back(top, 0.0);
+    return out;
+}
+
+void write_profile(const fs::path& file, const Simulation& sim) {
+    const auto outline = final_outline(sim);
+    if (outline.empty()) return;
+    std::string text = "height_m,radius_m\n";
+    for (const auto& [h, r] : outline) text += fmt::format("{:.6e},{:.6e}\n", h, r);
     write_text_file(file, text);
 }
 

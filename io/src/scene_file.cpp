@@ -1,4 +1,5 @@
 #include "gpa/io/scene_file.hpp"
+#include "gpa/io/reference.hpp"
 
 #include <array>
 #include <cstdint>
@@ -40,11 +41,12 @@ const std::vector<std::string_view> solver_keys{
     "connectivity", "switch_plastic_strain", "influence_distance", "weight",          "viscosity",
     "normalisation", "viscosity_linear", "viscosity_quadratic", "bond_viscosity_eps0", "hourglass_coefficient", "smoothing",     "smoothing_coefficient",
     "cfl",          "alpha_limit",           "max_time_step",      "time_step_growth", "failure",
-    "separate_failed", "energy_update",
+    "separate_failed", "energy_update", "node_diameter",
     "scatter",      "reorder_interval",      "neighbour_skin",
 };
 const std::vector<std::string_view> stop_keys{"end_time", "kinetic_energy_fraction", "max_steps", "energy_error"};
-const std::vector<std::string_view> output_keys{"snapshots", "snapshot_interval", "history_every", "checkpoint_every"};
+const std::vector<std::string_view> output_keys{"snapshots", "snapshot_interval", "history_every", "checkpoint_every",
+                                                "peak_radius"};
 
 const Choices<ConnectivityMode> connectivity_words{
     {"fixed", ConnectivityMode::Fixed}, {"variable", ConnectivityMode::Variable}, {"automatic", ConnectivityMode::Automatic}};
@@ -431,6 +433,9 @@ SolverOptions read_solver(const Reporter& reporter, const toml::table& table) {
     if (const auto v = r.choice<ConnectivityMode>("connectivity", connectivity_words)) s.connectivity = *v;
     if (const auto v = r.quantity("switch_plastic_strain", D::Dimensionless)) s.switch_plastic_strain = *v;
     if (const auto v = r.quantity("influence_distance", D::Dimensionless)) s.influence_distance = *v;
+    if (const auto v = r.choice<NodeDiameter>("node_diameter", {{"volume", NodeDiameter::Volume}, {"section", NodeDiameter::Section}, {"hoop", NodeDiameter::Hoop}})) {
+        s.node_diameter = *v;
+    }
     if (const auto v = r.choice<WeightKind>("weight", {{"gpa", WeightKind::Gpa}, {"sph-nsf", WeightKind::SphNsf}})) {
         s.weight = *v;
     }
@@ -509,6 +514,7 @@ OutputOptions read_output(const Reporter& reporter, const toml::table& table) {
             o.checkpoint_every_seconds = 0.0;
         }
     }
+    if (const auto v = r.quantity("peak_radius", D::Length, Limit::Positive)) o.peak_radius = *v;
     return o;
 }
 
@@ -517,10 +523,10 @@ void read_reference(const Reporter& reporter, const toml::table& table, Scene& s
     for (const auto& [key, node] : table) {
         const std::string path = fmt::format("reference.{}", printable(key.str()));
         const std::size_t line = line_of(node);
-        if (key.str() == "source") {
+        if (key.str() == "source" || key.str() == "elements") {
             const auto* s = node.as_string();
             if (!s) reporter.fail(line, path, fmt::format("expected a string, got {}", type_name(node)));
-            scene.reference_source = s->get();
+            (key.str() == "source" ? scene.reference_source : scene.element_reference) = s->get();
             continue;
         }
         double value = 0.0;
@@ -585,6 +591,9 @@ Scene read_scene(std::string_view text, const Reporter& reporter, std::vector<st
     scene.stop = read_stop(reporter, sub_table(top, "stop", empty));
     scene.output = read_output(reporter, sub_table(top, "output", empty));
     read_reference(reporter, sub_table(top, "reference", empty), scene);
+    // The neighbourhood of local peaks is fixed by the scene as written (twice its first body's
+    // spacing unless given), so that the refined runs of a study measure over the same one.
+    if (scene.output.peak_radius == 0.0 && !scene.bodies.empty()) scene.output.peak_radius = 2.0 * scene.bodies.front().spacing;
     return scene;
 }
 
@@ -631,6 +640,19 @@ std::string read_scene_text(const std::filesystem::path& file) {
     return text;
 }
 
-Scene load_scene(const std::filesystem::path& file) { return parse_scene(read_scene_text(file), file.string()); }
+Scene load_scene(const std::filesystem::path& file) {
+    Scene scene = parse_scene(read_scene_text(file), file.string());
+    if (!scene.element_reference.empty() && std::filesystem::path(scene.element_reference).is_relative()) {
+        scene.element_reference = (file.parent_path() / scene.element_reference).lexically_normal().string();
+    }
+    if (!scene.element_reference.empty()) {
+        try {
+            read_element_reference(scene.element_reference);
+        } catch (const InputError& e) {
+            throw InputError(fmt::format("{}: reference.elements: {}", file.string(), e.what()));
+        }
+    }
+    return scene;
+}
 
 }  // namespace gpa::io

@@ -89,6 +89,7 @@ const std::vector<ChoiceKey> choice_keys{
     {"viscosity", {"none", "nodal", "bond"}},
     {"smoothing", {"off", "tension", "everywhere"}},
     {"discretisation", {"particles", "elements"}},
+    {"node_diameter", {"volume", "section", "hoop"}},
 };
 
 const std::vector<const char*> number_keys{
@@ -164,6 +165,25 @@ const std::map<std::string, CaseErrors>& errors_of(const StudyAnalysis& a, std::
 double metric_value(const StudyCase& c, const std::string& key) {
     const auto it = c.metrics.find(key);
     return c.finished && it != c.metrics.end() ? it->second : nan;
+}
+
+// The ratio columns against an element reference: (metric key, column name, table heading).
+const std::vector<std::array<const char*, 3>> ratio_columns{
+    {"final_length", "L_star", "L*"},
+    {"footprint_diameter", "D_star", "D*"},
+    {"plastic_work", "PW_star", "PW*"},
+    {"peak_plastic_strain", "peak_plastic_strain_star", "peak strain*"},
+    {"peak_temperature", "peak_temperature_star", "peak T*"},
+};
+
+std::map<std::string, double> ratios_of(const StudyReport& report, const StudyCase& c) {
+    if (!report.element_reference || !c.finished) return {};
+    return compare_with_reference(c.metrics, c.outline, *report.element_reference);
+}
+
+double ratio_value(const std::map<std::string, double>& r, const std::string& key) {
+    const auto it = r.find(key);
+    return it != r.end() ? it->second : nan;
 }
 
 }  // namespace
@@ -378,6 +398,8 @@ void apply_variant(const Variant& variant, Scene& scene) {
             o.viscosity = value == "none" ? ViscosityKind::None : value == "nodal" ? ViscosityKind::Nodal : ViscosityKind::Bond;
         } else if (key == "smoothing") {
             o.smoothing = value == "off" ? SmoothingMode::Off : value == "tension" ? SmoothingMode::Tension : SmoothingMode::Everywhere;
+        } else if (key == "node_diameter") {
+            o.node_diameter = value == "section" ? NodeDiameter::Section : value == "hoop" ? NodeDiameter::Hoop : NodeDiameter::Volume;
         } else if (key == "discretisation") {
             // Every body, meshed from the same shape at the same spacing; the particle-only body
             // keys go, since they do not apply to element bodies.
@@ -436,6 +458,12 @@ const std::vector<MetricInfo>& study_metrics() {
         {"contact_time", "s", "us", 1e6, true, "time from the onset of contact with the first rigid plane to lift-off"},
         {"rebound_speed", "m/s", "m/s", 1.0, true, "|momentum along the plane normal| / mass after lift-off"},
         {"plastic_work", "J", "J", 1.0, true, "plastic work at the end"},
+        {"peak_plastic_strain", "", "", 1.0, true,
+         "largest mean equivalent plastic strain over a neighbourhood of the scene's peak_radius at the end (docs/measurement.md)"},
+        {"peak_temperature", "K", "K", 1.0, true,
+         "largest mean temperature over a neighbourhood of the scene's peak_radius at the end (docs/measurement.md)"},
+        {"face_roughness", "", "", 1.0, false,
+         "node-to-node scatter of the plastic strain along the impact face at the end (docs/measurement.md)"},
         {"energy_error", "", "%", 100.0, false, "(KE + IE + boundary work - E0) / (E0 + positive prescribed-velocity work) at the end"},
         {"variable_fraction", "", "%", 100.0, false, "share of the real nodes with variable connectivity at the end"},
         {"hourglass_work", "J", "J", 1.0, false, "work of the hourglass control of lattice-regime nodes at the end"},
@@ -487,15 +515,21 @@ std::map<std::string, double> RunProbe::metrics(const Simulation& sim) const {
                                     {"energy_error", t.energy_error},
                                     {"variable_fraction", static_cast<double>(t.variable_nodes) / static_cast<double>(t.real_nodes)},
                                     {"hourglass_work", t.hourglass_work}};
+    if (t.local.measured && t.local.plastic_strain.points > 0) {
+        m["peak_plastic_strain"] = t.local.plastic_strain.value;
+        m["peak_temperature"] = t.local.temperature.value;
+        m["peak_radius"] = t.local.radius;  // not a study metric: tells the reference comparison the neighbourhood
+        if (t.local.face_points >= 3) m["face_roughness"] = t.local.face_roughness;
+    }
     if (plane_ < 0) return m;
     const bool left = lift_off_ && contact_start_ >= 0.0 && !touching_ && contact_end_ >= 0.0;
     if (left) {
         m["contact_time"] = contact_end_ - contact_start_;
         m["rebound_speed"] = mass_ > 0.0 ? std::abs(t.momentum[static_cast<std::size_t>(axis_)]) / mass_ : nan;
-    } else {
-        m["final_length"] = t.length;
-        m["footprint_diameter"] = t.footprint_diameter;
     }
+    // Measured on the body itself (docs/measurement.md), so they hold after lift-off too.
+    m["final_length"] = t.length;
+    m["footprint_diameter"] = t.footprint_diameter;
     return m;
 }
 
@@ -564,6 +598,10 @@ void write_study_csv(const fs::path& file, const StudyReport& report, const Stud
             if (report.reference.count(key)) s += fmt::format(",{}_reference_error", key);
         }
     }
+    if (report.element_reference) {
+        for (const auto& col : ratio_columns) s += fmt::format(",{}", col[1]);
+        s += ",outline_distance_m";
+    }
     s += ",message\n";
     for (std::size_t k = 0; k < report.cases.size(); ++k) {
         const auto& c = report.cases[k];
@@ -581,6 +619,11 @@ void write_study_csv(const fs::path& file, const StudyReport& report, const Stud
             const CaseErrors err = e != errors.end() ? e->second : CaseErrors{};
             s += fmt::format(",{}", csv_number(err.discretisation));
             if (report.reference.count(key)) s += fmt::format(",{}", csv_number(err.reference));
+        }
+        if (report.element_reference) {
+            const auto r = ratios_of(report, c);
+            for (const auto& col : ratio_columns) s += fmt::format(",{}", csv_number(ratio_value(r, col[0])));
+            s += fmt::format(",{}", csv_number(ratio_value(r, "outline_distance")));
         }
         s += fmt::format(",{}\n", csv_field(c.message));
     }
@@ -702,6 +745,30 @@ void write_study_markdown(const fs::path& file, const StudyReport& report, const
                 }
             }
             s += "\n";
+        }
+    }
+    if (report.element_reference) {
+        const auto& ref = *report.element_reference;
+        s += fmt::format("\n## Against the element reference\n\nThe scene's element reference `{}` ({} at {}, {}; "
+                         "docs/validation.md): each case's value over the reference's (the paper's L*, D*, PW*), and the mean "
+                         "distance between the final outlines.\n\n| metric | reference | kind | uncertainty |\n|---|---|---|---|\n",
+                         report.scene_file.empty() ? ref.scene : ref.scene, ref.variant, ref.commit, ref.date);
+        for (const auto& [key, v] : ref.values) {
+            const auto* m = find_study_metric(key);
+            const double scale = m ? m->display_scale : 1.0;
+            const std::string unit = m ? m->display_unit : "";
+            s += fmt::format("| {} | {} {} | {} | {} {} |\n", key, cell(v.value * scale, 6), unit, v.kind, cell(v.uncertainty * scale, 3), unit);
+        }
+        s += "\n| series | refinement | cell mm | wall s |";
+        for (const auto& col : ratio_columns) s += fmt::format(" {} |", col[2]);
+        s += " outline distance mm |\n|---|---|---|---|";
+        for (std::size_t k = 0; k < ratio_columns.size(); ++k) s += "---|";
+        s += "---|\n";
+        for (const auto& c : report.cases) {
+            const auto r = ratios_of(report, c);
+            s += fmt::format("| {} | {:g} | {} | {} |", c.series, c.refinement, cell(c.cell_size * 1e3), cell(c.wall_seconds, 3));
+            for (const auto& col : ratio_columns) s += fmt::format(" {} |", cell(ratio_value(r, col[0]), 5));
+            s += fmt::format(" {} |\n", cell(ratio_value(r, "outline_distance") * 1e3, 3));
         }
     }
     write_text_file(file, s);

@@ -97,6 +97,27 @@ expect 0 "study, two resolutions" -- "$gpa" study "$bar" -o study2 --refine 1,2 
 [[ $(( $(wc -l < study2/study.csv) - 1 )) -eq 2 ]] || fail "two-resolution study.csv rows"
 grep -q "fewer than three resolutions" study2/study.md || fail "two-resolution study.md does not say why there is no order"
 
+# 7. gpa study --reference: the element version of the bar at three resolutions is written as an
+#    element reference; a scene that names it gets the ratio columns and section; a scene naming a
+#    file that is not there is refused at once, naming the key.
+expect 0 "study --reference" -- "$gpa" study "$bar" -o study-el --refine 1,1.5,2 --threads 1 \
+  --variant elements:discretisation=elements --reference ref.toml -q
+[[ -s ref.toml ]] || fail "study --reference wrote no file"
+grep -q '^\[values.final_length\]' ref.toml || fail "the reference has no final length: $(head -c 600 ref.toml)"
+grep -q '^kind = "' ref.toml || fail "the reference values have no kind"
+grep -q '^\[outline\]' ref.toml || fail "the reference has no outline"
+grep -q '^commit = "' ref.toml || fail "the reference has no commit"
+sed "s#^source = \"one-dimensional elastic wave theory\"#&\nelements = \"$PWD/ref.toml\"#" "$bar" > bar-ref.toml
+grep -q '^elements = ' bar-ref.toml || fail "could not make the scene with a reference"
+expect 0 "study against a reference" -- "$gpa" study bar-ref.toml -o study-ref --refine 1,1.5,2 --threads 1 -q
+head -1 study-ref/study.csv | grep -q "L_star,D_star,PW_star" || fail "study.csv lacks the ratio columns: $(head -1 study-ref/study.csv)"
+grep -q "Against the element reference" study-ref/study.md || fail "study.md lacks the element reference section"
+expect 0 "run against a reference" -- "$gpa" run bar-ref.toml -o run-ref -q
+grep -q '"element_reference": {"file"' run-ref/summary.json || fail "summary.json lacks the element reference"
+sed "s#^source = \"one-dimensional elastic wave theory\"#&\nelements = \"no-such-reference.toml\"#" "$bar" > bar-noref.toml
+expect 2 "scene naming a missing reference" -- "$gpa" check bar-noref.toml
+grep -q "reference.elements" err.txt || fail "the message does not name reference.elements: $(cat err.txt)"
+
 # Bad options: one line naming the option, exit 2, and no output folder.
 study_refused() {
   local what=$1 fragment=$2; shift 2
@@ -108,6 +129,8 @@ study_refused "refine not a number" "--refine '1,x'" --refine 1,x
 study_refused "refine twice" "listed twice" --refine 1,2,1
 study_refused "refine zero" "positive refinement factor" --refine 0,1
 study_refused "threads" "--threads" --threads 1,-1
+study_refused "reference from two series" "--reference" --refine 1,1.5,2 --variant a --variant b:weight=sph --reference r.toml
+study_refused "reference from two resolutions" "--reference" --refine 1,2 --reference r.toml
 study_refused "unknown variant key" "unknown key 'colour'" --variant x:colour=red
 study_refused "bad variant value" "weight must be one of gpa, sph, sph-nsf" --variant x:weight=foo
 study_refused "variant without a name" "name before its settings" --variant weight=sph

@@ -87,6 +87,9 @@ TEST(SceneFormatDoc, DefaultsAreThoseOfSceneHpp) {
     expect_word(doc, "connectivity", word(s.connectivity));
     expect_number(doc, "switch_plastic_strain", s.switch_plastic_strain);
     expect_number(doc, "influence_distance", s.influence_distance);
+    expect_word(doc, "node_diameter", s.node_diameter == NodeDiameter::Hoop     ? "\"hoop\""
+                                      : s.node_diameter == NodeDiameter::Volume ? "\"volume\""
+                                                                                : "\"section\"");
     expect_word(doc, "weight", word(s.weight));
     expect_word(doc, "normalisation", word(s.normalisation));
     expect_word(doc, "viscosity", word(s.viscosity));
@@ -120,10 +123,13 @@ TEST(SceneFormatDoc, DefaultsAreThoseOfSceneHpp) {
     // checkpoint_every: a wall-clock time by default, documented with its unit.
     EXPECT_EQ(o.checkpoint_every_steps, 0u);
     expect_word(doc, "checkpoint_every", fmt::format("\"{:g} min\"", o.checkpoint_every_seconds / 60.0));
+    // peak_radius: 0 in scene.hpp, which the scene reader replaces by twice the first body's spacing.
+    EXPECT_EQ(o.peak_radius, 0.0);
+    expect_word(doc, "peak_radius", " twice the first body's spacing as written ");  // a cell without a `value`: as written
 
-    // 22 solver options, 4 stop criteria, 4 output options, and no row for an option that does
+    // 23 solver options, 4 stop criteria, 5 output options, and no row for an option that does
     // not exist.
-    EXPECT_EQ(doc.size(), 30u) << "rows in [solver], [stop] and [output] of docs/scene-format.md";
+    EXPECT_EQ(doc.size(), 32u) << "rows in [solver], [stop] and [output] of docs/scene-format.md";
 }
 
 }  // namespace

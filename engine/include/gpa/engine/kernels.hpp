@@ -4,6 +4,7 @@
 // the neighbour lists. Equation numbers are those of Johnson, Beissel and Stryk
 // (Comput. Mech. 25, 2000), restated in shared/spec/gpa-method.md.
 
+#include <algorithm>
 #include <cmath>
 
 #include <Eigen/Core>
@@ -188,11 +189,20 @@ inline double lattice_cell_ratio(const Mat<D>& current_edges, const Mat<D>& init
 // Eq. 3 and its plane-strain and 3D analogues (spec section 2):
 //   axisymmetric d = d0 sqrt((1 + eps_v) x0 / x), plane strain d = d0 sqrt(1 + eps_v),
 //   3D d = d0 (1 + eps_v)^(1/3).
+// With `section` false (NodeDiameter::Volume, the [spec] entry of issue 13) the axisymmetric
+// diameter leaves out x0 / x and follows the node's volume like the other geometries:
+// d = d0 sqrt(1 + eps_v). A ring that spreads radially at an impact face (x / x0 = lambda) is
+// stretched radially and around the hoop and thinned axially; Eq. 3 shrinks its d by
+// 1 / sqrt(lambda) while its radial neighbours move lambda times further away, so that they leave
+// the radius of influence (at lambda = 1.4 a radial neighbour already weighs R = 0.1 instead of 0.5).
+// rule: 0 Eq. 3 (section), 1 volume, 2 hoop (max(x / x0, x0 / x) in place of x0 / x).
 template <class G>
-inline double node_diameter(double d0, double eps_v, double x0, double x) {
+inline double node_diameter(double d0, double eps_v, double x0, double x, int rule = 0) {
     if constexpr (G::dim == 3) {
         return d0 * std::cbrt(1.0 + eps_v);
     } else if constexpr (G::axisymmetric) {
+        if (rule == 1) return d0 * std::sqrt(1.0 + eps_v);
+        if (rule == 2) return d0 * std::sqrt((1.0 + eps_v) * std::max(x / x0, x0 / x));
         return d0 * std::sqrt((1.0 + eps_v) * x0 / x);
     } else {
         return d0 * std::sqrt(1.0 + eps_v);

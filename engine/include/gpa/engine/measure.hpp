@@ -1,64 +1,110 @@
 #pragma once
-// How a body's final length and footprint are measured, for particle bodies and element bodies
-// alike (docs/measurement.md states the rules; this header is their one implementation, used by
-// the run totals, the summary, the profile and the study).
+// How a body's final length, footprint and local peaks are measured, for particle bodies and
+// element bodies alike (docs/measurement.md states the rules; this header is their one
+// implementation, used by the run totals, the summary, the profile and the study).
 //
-// Both are taken against the first rigid plane of a scene: "height" is a point's distance from
-// the plane on the bodies' side of it, "across" its coordinate along the plane's first other
-// axis (the radius x in an axisymmetric scene with the plane normal to z).
+// Length and footprint are taken against the first rigid plane of a scene: "height" is a point's
+// distance from the plane on the bodies' side of it, "across" its coordinate along the plane's
+// first other axis (the radius x in an axisymmetric scene with the plane normal to z). The plane
+// gives the direction; the body itself gives the base it is measured from:
 //
 //   particles: a node is the centre of a cell of diameter d, so the body reaches d/2 beyond it:
 //     top       = height + d/2
-//     on face   = height < d            (the first row stands d/2 above the plane)
+//     lowest    = height - d/2
+//     on face   = height - base < d     (the first row stands d/2 above the base)
 //     span      = [across - d/2, across + d/2]
 //   elements:  nodes lie on the body's boundary, so the body ends at them:
 //     top       = height
-//     on face   = height <= face tolerance (nodes in contact lie on the plane to round-off)
+//     lowest    = height
+//     on face   = height - base <= face tolerance (nodes in contact lie on the plane to round-off)
 //     span      = [across, across]
+//
+// The base is the plane while the body stands on it (some point meets the face rule with base 0),
+// otherwise the body's lowest point: a body that has lifted off is measured from its own underside,
+// so its length does not include the gap and its footprint is that of its base. Length = top - base.
 //
 // In an axisymmetric body the footprint is a diameter: a span [lo, hi] of radii counts as
 // [-hi, hi] (the body is symmetric about the axis).
 
 #include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstddef>
 #include <limits>
+#include <span>
+#include <string>
+#include <vector>
 
 namespace gpa::measure {
 
 // The running extent of one or more bodies above a plane.
+//
+// Heights passed to add_particle and add_element_node are taken from a base: the plane (base 0)
+// in a first pass; when that pass finds no point on the plane (standing() is false) the caller
+// repeats it with heights less lowest() (the body's underside), as measure_extent does.
 struct Extent {
     double top = -std::numeric_limits<double>::infinity();
+    double lowest = std::numeric_limits<double>::infinity();
     double face_lo = std::numeric_limits<double>::infinity();
     double face_hi = -std::numeric_limits<double>::infinity();
 
     Extent& operator+=(const Extent& o) {
         top = std::max(top, o.top);
+        lowest = std::min(lowest, o.lowest);
         face_lo = std::min(face_lo, o.face_lo);
         face_hi = std::max(face_hi, o.face_hi);
         return *this;
     }
-    // Final length: the highest point above the plane (0 when nothing was seen).
-    double length() const { return top > -std::numeric_limits<double>::infinity() ? top : 0.0; }
-    // Footprint diameter: the width of the points on the plane (0 when none is on it).
+    bool seen() const { return top > -std::numeric_limits<double>::infinity(); }
+    // Some point met the face rule: the body stands on its base.
+    bool standing() const { return face_hi >= face_lo; }
+    // Final length: the highest point above the base (0 when nothing was seen).
+    double length() const { return seen() ? top : 0.0; }
+    // Footprint diameter: the width of the points on the base (0 when none is on it).
     double footprint() const { return face_hi > face_lo ? face_hi - face_lo : 0.0; }
 };
 
-// A particle node of diameter d at `height` above the plane and `across` along it.
+// The size of a particle node's cell, which the measurement rules take as its d: the square root
+// of its section A (its size weight W, Eq. 4) in 2D, the cube root of its volume in 3D. With Eq. 3
+// this is the node's diameter itself; it stays the cell's size when the support diameter of Eq. 2
+// follows another rule (SolverOptions::node_diameter).
+inline double particle_cell_size(double size_weight, int dim) { return dim == 3 ? std::cbrt(size_weight) : std::sqrt(size_weight); }
+
+// A particle node whose cell is d wide at `height` above the base and `across` along it.
 inline void add_particle(Extent& e, double height, double across, double diameter, bool axisymmetric) {
     const double half = 0.5 * diameter;
     e.top = std::max(e.top, height + half);
+    e.lowest = std::min(e.lowest, height - half);
     if (height < diameter) {
         e.face_hi = std::max(e.face_hi, across + half);
         e.face_lo = std::min(e.face_lo, axisymmetric ? -(across + half) : across - half);
     }
 }
 
-// An element node (on the body's boundary or inside it) at `height` above the plane.
+// An element node (on the body's boundary or inside it) at `height` above the base.
 inline void add_element_node(Extent& e, double height, double across, double face_tolerance, bool axisymmetric) {
     e.top = std::max(e.top, height);
+    e.lowest = std::min(e.lowest, height);
     if (height <= face_tolerance) {
         e.face_hi = std::max(e.face_hi, across);
         e.face_lo = std::min(e.face_lo, axisymmetric ? -across : across);
     }
+}
+
+// The two passes: `pass(base)` returns the extent of every point with heights measured from
+// `base`. The first pass measures from the plane; a body that does not stand on it (it has lifted
+// off, or has not arrived) is measured again from its lowest point. Returns the extent and, in
+// `base`, the height of the base above the plane (0 while the body stands on the plane).
+template <class Pass>
+Extent measure_extent(Pass&& pass, double* base = nullptr) {
+    Extent e = pass(0.0);
+    double b = 0.0;
+    if (e.seen() && !e.standing()) {
+        b = e.lowest;
+        e = pass(b);
+    }
+    if (base) *base = b;
+    return e;
 }
 
 // The tolerance of "on the plane" for element nodes of a body meshed at spacing h: contact puts
@@ -70,5 +116,44 @@ inline double element_face_tolerance(double spacing) { return 1e-6 * spacing; }
 // node's: the same offsets as the spans above.
 inline double particle_outline_radius(double across, double diameter) { return across + 0.5 * diameter; }
 inline double element_outline_radius(double across) { return across; }
+
+// --- local peaks ---------------------------------------------------------------------------
+//
+// A local field (equivalent plastic strain, temperature) is measured at its material points: a
+// particle node, or an element's triangle (its centroid). The peak of a field is taken over a
+// stated neighbourhood, the same for particles and elements, so that it does not depend on how
+// finely the material is sampled:
+//
+//   mean(p) = sum_q w_q f_q / sum_q w_q   over the points q of p's body with |x_q - x_p| <= radius,
+//   peak    = max over the points p of mean(p), and where it is (the point p);
+//
+// w_q is the point's share of the body's section: a node's size weight W (A_j in 2D, Eq. 4; V_j
+// in 3D), a triangle's area. The largest value at a single point (the raw maximum) is kept too.
+// Ties go to the lowest index, so the answer does not depend on the thread count.
+struct FieldPoint {
+    std::array<double, 3> position{0, 0, 0};  // m (2D: x, z in the first two)
+    double weight = 0.0;                      // section share, m^2 (2D) or m^3 (3D)
+    double value = 0.0;
+    int body = 0;
+};
+
+struct LocalPeak {
+    double value = 0.0;                         // largest neighbourhood mean
+    std::array<double, 3> position{0, 0, 0};    // the point it is centred on
+    double raw = 0.0;                           // largest value at one point
+    std::array<double, 3> raw_position{0, 0, 0};
+    std::size_t points = 0;                     // points measured (0: no peak)
+};
+
+// The peak of `points` over neighbourhoods of `radius` (> 0) in `dim` (2 or 3) dimensions.
+// Throws std::invalid_argument for a radius that is not positive and finite.
+LocalPeak local_peak(std::span<const FieldPoint> points, double radius, int dim);
+
+// Roughness of a field along the impact face, the measure of node-to-node scatter: the face
+// points ordered by their coordinate across the plane, the mean over the inner ones of
+// |f_k - (f_(k-1) + f_(k+1)) / 2| (a linear trend gives 0; values alternating between a - e and
+// a + e from point to point give 2 e).
+// `across` and `value` are the face points in any order; fewer than three give 0.
+double face_roughness(std::span<const double> across, std::span<const double> value);
 
 }  // namespace gpa::measure

@@ -127,10 +127,25 @@ enum class EnergyUpdate {
     Point,       // the point update's own mid-step energy equation (materials.md; not exactly conservative)
 };
 
+// How a particle node's diameter d (the length of Eq. 2's h_ij = a (d_i + d_j) / 2) follows the
+// deformation (spec section 2; docs/validation.md, "Local fields at the impact face").
+enum class NodeDiameter {
+    // d = d0 sqrt(V / V0) in 2D, d0 (V / V0)^(1/3) in 3D: the node's volume alone ([spec] entry of
+    // issue 13). In axisymmetric geometry this leaves out Eq. 3's factor x0 / x.
+    Volume,
+    // Eq. 3 as printed: d = d0 sqrt((1 + eps_v) x0 / x) in axisymmetric geometry (the ring's
+    // section), the same as Volume otherwise.
+    Section,
+    // d = d0 sqrt((1 + eps_v) max(x / x0, x0 / x)) in axisymmetric geometry: the hoop stretch
+    // lambda = x / x0 enlarges the support whichever way it goes; the same as Volume otherwise.
+    Hoop,
+};
+
 struct SolverOptions {
     ConnectivityMode connectivity = ConnectivityMode::Variable;
     double switch_plastic_strain = 0.1;  // Automatic: switch at this equivalent plastic strain
     double influence_distance = 1.0;     // a, 0.8-1.5 (Eq. 2)
+    NodeDiameter node_diameter = NodeDiameter::Hoop;
     WeightKind weight = WeightKind::Gpa;
     Normalisation normalisation = Normalisation::PerDirection;
     ViscosityKind viscosity = ViscosityKind::Nodal;
@@ -188,6 +203,10 @@ struct OutputOptions {
     // time (s); 0 = never (a run still writes one when it is interrupted).
     std::size_t checkpoint_every_steps = 0;
     double checkpoint_every_seconds = 600.0;
+    // Radius of the neighbourhood over which local peaks (plastic strain, temperature) are averaged
+    // (measure.hpp), m; 0 = twice the first body's spacing. The scene reader fixes it from the scene
+    // as written, so that a study's refined runs keep one radius.
+    double peak_radius = 0.0;
 };
 
 struct Scene {
@@ -205,6 +224,9 @@ struct Scene {
     // "final_length" and "footprint_diameter" (m) of a Taylor test. Keys are free-form words.
     std::map<std::string, double> reference;
     std::string reference_source;
+    // [reference] elements: the file of the scene's element reference (gpa study --reference), as
+    // written; relative paths are taken from the scene file's folder (io::load_scene resolves them).
+    std::string element_reference;
 };
 
 // Throws InputError naming the body, plane or option when the scene is impossible (no bodies,

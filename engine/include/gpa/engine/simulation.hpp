@@ -39,6 +39,7 @@
 #include "gpa/engine/limits.hpp"
 #include "gpa/engine/node_store.hpp"
 #include "gpa/engine/phase_graph.hpp"
+#include "gpa/engine/measure.hpp"
 #include "gpa/engine/scene.hpp"
 
 namespace gpa {
@@ -99,8 +100,21 @@ struct Totals {
     // Final length and footprint against the first rigid plane, by the rules of measure.hpp
     // (docs/measurement.md): particles reach d/2 beyond their centres, element nodes lie on the
     // boundary.
-    double length = 0.0;              // highest point above the plane, m
-    double footprint_diameter = 0.0;  // width of the body on the plane, m
+    double length = 0.0;              // highest point above the base, m
+    double footprint_diameter = 0.0;  // width of the body on its base, m
+    double base_height = 0.0;         // the base above the plane: 0 while the body stands on it, m
+    // Local peaks (measure.hpp, docs/measurement.md): equivalent plastic strain and temperature,
+    // each the largest mean over a neighbourhood of `local_radius`, with where it is and the largest
+    // value at a single point; the roughness of the plastic strain along the impact face. Measured by
+    // Simulation::measure_bodies(), not every step.
+    struct LocalFields {
+        bool measured = false;
+        double radius = 0.0;                     // m
+        measure::LocalPeak plastic_strain;
+        measure::LocalPeak temperature;          // K
+        double face_roughness = 0.0;             // of the plastic strain (measure::face_roughness)
+        std::size_t face_points = 0;             // points on the face it was measured over
+    } local;
     std::size_t real_nodes = 0, ghost_nodes = 0, variable_nodes = 0, failed_nodes = 0, pairs = 0;
     std::size_t element_nodes = 0, elements = 0;  // nodes and quadrilaterals of element bodies
     std::size_t neighbour_searches = 0;  // full searches so far (the others steps reuse candidate lists)
@@ -148,8 +162,9 @@ public:
     std::size_t real_count() const;
     const Totals& totals() const;
     // Measures the bodies' pieces, residual velocities and craters (body_report.hpp) from the
-    // current state into totals().bodies; the run program calls it before every history row and the
-    // summary (it is a union-find over the lists, too much to do every step).
+    // current state into totals().bodies, and the local peaks into totals().local; the run program
+    // calls it before every history row and the summary (a union-find over the lists and a
+    // neighbourhood sum per point, too much to do every step).
     void measure_bodies();
     double time() const;
     std::size_t steps() const;

@@ -139,4 +139,13 @@ struct ReferenceComparison {
 };
 std::vector<ReferenceComparison> compare_with_reference(const Simulation& sim);
 
+// The metrics of a run that a reference may state: final_length, footprint_diameter,
+// plastic_work, and peak_plastic_strain, peak_temperature once measure_bodies() has measured them.
+std::map<std::string, double> run_metrics(const Simulation& sim);
+
+// The summary's "element_reference" object (JSON) when the scene names an element reference: for
+// each of its metrics the reference, the computed value and their ratio (L*, D*, PW*, ...), and the
+// outline distance; empty when the scene names none.
+std::string element_reference_json(const Simulation& sim);
+
 }  // namespace gpa::io

@@ -20,6 +20,7 @@
 
 #include "gpa/engine/scene.hpp"
 #include "gpa/engine/simulation.hpp"
+#include "gpa/io/reference.hpp"
 
 namespace gpa::io {
 
@@ -139,13 +140,16 @@ struct MetricInfo {
 };
 
 // Every metric a study may report, in table order: final_length, footprint_diameter,
-// contact_time, rebound_speed, plastic_work, energy_error, variable_fraction, hourglass_work.
+// contact_time, rebound_speed, plastic_work, peak_plastic_strain, peak_temperature, face_roughness,
+// energy_error, variable_fraction, hourglass_work.
 const std::vector<MetricInfo>& study_metrics();
 const MetricInfo* find_study_metric(std::string_view key);
 
 // Follows a run step by step and gives its metrics at the end:
 //   final_length, footprint_diameter: Totals.length and .footprint_diameter when the scene has a
-//     rigid plane and the bodies have not left it (see below);
+//     rigid plane (measured on the body itself, so also after it has left the plane);
+//   peak_plastic_strain, peak_temperature, face_roughness: Totals.local, when the caller has called
+//     Simulation::measure_bodies() before metrics();
 //   contact_time, rebound_speed: when the first rigid plane allows lift-off and the bodies touched
 //     it and then left it for good: the time from the onset of contact to its end (each placed
 //     half way between the last step on one side and the first on the other) and
@@ -189,6 +193,7 @@ struct StudyCase {
     double peak_bytes = std::numeric_limits<double>::quiet_NaN();  // the process's high-water mark during the run
     double case_bytes = std::numeric_limits<double>::quiet_NaN();  // that minus the resident size before it
     std::map<std::string, double> metrics;
+    std::vector<std::pair<double, double>> outline;  // final outline (io::final_outline), m
 };
 
 struct StudyReport {
@@ -201,6 +206,9 @@ struct StudyReport {
     std::string reference_source;
     std::string memory_note;                         // how peak memory was measured
     std::vector<StudyCase> cases;
+    // The scene's element reference ([reference] elements), when it names one: each case is
+    // also reported as ratios to it (L*, D*, PW*, the peaks) and its outline distance.
+    std::optional<ElementReference> element_reference;
 };
 
 // Errors of one case against the extrapolation of its series and against the scene's answer.

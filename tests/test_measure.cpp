@@ -1,0 +1,256 @@
+// The measurement rules of issue 13 (measure.hpp, docs/measurement.md): a body measured from its
+// own base after it has left the plane, local peaks over a neighbourhood, the roughness of a field
+// along the impact face; and the element reference (io/reference.hpp): the rule that makes a
+// study's series a reference, its file, the outline distance and the ratios.
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "gpa/engine/errors.hpp"
+#include "gpa/engine/kernels.hpp"
+#include "gpa/engine/measure.hpp"
+#include "gpa/engine/simulation.hpp"
+#include "gpa/io/reference.hpp"
+#include "gpa/io/scene_file.hpp"
+#include "gpa/io/study.hpp"
+
+namespace gpa {
+namespace {
+
+namespace fs = std::filesystem;
+
+TEST(MeasureBase, ABodyOffThePlaneIsMeasuredFromItsUnderside) {
+    // Two particle rows of cells 1 mm wide, 3 mm above the plane: a body that has lifted off.
+    const auto pass = [](double base) {
+        measure::Extent e;
+        for (double x : {0.5, 1.5}) {
+            measure::add_particle(e, 3.5 - base, x, 1.0, true);
+            measure::add_particle(e, 4.5 - base, x, 1.0, true);
+        }
+        return e;
+    };
+    EXPECT_FALSE(pass(0.0).standing());  // nothing within a cell of the plane
+    double base = -1.0;
+    const measure::Extent e = measure::measure_extent(pass, &base);
+    EXPECT_DOUBLE_EQ(base, 3.0);         // the lowest reach: 3.5 - 1/2
+    EXPECT_DOUBLE_EQ(e.length(), 2.0);   // two rows of 1 mm, not 5 mm above the plane
+    EXPECT_DOUBLE_EQ(e.footprint(), 4.0);  // the bottom row's radii 0.5 and 1.5 plus half a cell: a 4 mm disc
+    // A body standing on the plane keeps the plane as its base.
+    const auto standing = [](double b) {
+        measure::Extent x;
+        measure::add_particle(x, 0.5 - b, 0.5, 1.0, true);
+        measure::add_particle(x, 1.5 - b, 0.5, 1.0, true);
+        return x;
+    };
+    measure::measure_extent(standing, &base);
+    EXPECT_EQ(base, 0.0);
+    // Elements: the lowest node is the base.
+    const auto elements = [](double b) {
+        measure::Extent x;
+        measure::add_element_node(x, 2.0 - b, 0.0, 1e-9, true);
+        measure::add_element_node(x, 2.0 - b, 3.0, 1e-9, true);
+        measure::add_element_node(x, 7.0 - b, 3.0, 1e-9, true);
+        return x;
+    };
+    const measure::Extent el = measure::measure_extent(elements, &base);
+    EXPECT_DOUBLE_EQ(base, 2.0);
+    EXPECT_DOUBLE_EQ(el.length(), 5.0);
+    EXPECT_DOUBLE_EQ(el.footprint(), 6.0);
+}
+
+TEST(MeasureBase, AnElasticBarThatBouncedOffKeepsItsLengthAndFootprint) {
+    Scene s = io::load_scene(std::string(GPA_SOURCE_DIR) + "/scenes/elastic-bar.toml");
+    s.bodies[0].spacing = 0.25e-3;  // 4 across the 1 mm radius: enough for a length
+    s.stop.end_time = 50e-6;        // contact ends near 8 us; the bar then flies 40 us at ~10 m/s
+    Simulation sim(s, 1);
+    while (!sim.finished()) sim.step();
+    const auto& t = sim.totals();
+    std::printf("[ measured ] after lift-off: base %.4f mm above the plane, length %.4f mm, footprint %.4f mm\n",
+                t.base_height * 1e3, t.length * 1e3, t.footprint_diameter * 1e3);
+    // It has left: about 0.4 mm of air under it (10 m/s for 40 us), more than a cell.
+    EXPECT_GT(t.base_height, 0.3e-3);
+    // The body's own length: 20 mm, to the free vibration's strain v/c = 10 / 5064 = 0.2 % and a
+    // fraction of a cell (0.25 mm = 1.25 % of the length) of the d/2 reach at its ends.
+    EXPECT_NEAR(t.length, 20e-3, 0.01 * 20e-3);
+    // Its base is the bar's end face, 2 mm across, to within one cell.
+    EXPECT_NEAR(t.footprint_diameter, 2e-3, 0.25e-3);
+}
+
+TEST(LocalPeak, AUniformFieldIsItsOwnPeakAndASpikeIsAveraged) {
+    std::vector<measure::FieldPoint> points;
+    for (int i = 0; i < 20; ++i) {
+        for (int k = 0; k < 20; ++k) {
+            measure::FieldPoint p;
+            p.position = {0.1 * i + 0.05, 0.1 * k + 0.05, 0.0};
+            p.weight = 0.01;
+            p.value = 1.0;
+            points.push_back(p);
+        }
+    }
+    const auto uniform = measure::local_peak(points, 0.25, 2);
+    EXPECT_NEAR(uniform.value, 1.0, 1e-15);
+    EXPECT_EQ(uniform.raw, 1.0);
+    // One point at 11 whose 4 axis neighbours hold 2, among ones, equal weights: within 0.12 a
+    // point has its 4 axis neighbours, so the mean centred on the spike is (11 + 4 x 2) / 5 = 3.8
+    // (on a neighbour (2 + 11 + 3) / 5 = 3.2); the raw maximum stays 11.
+    points[10 * 20 + 10].value = 11.0;
+    for (int n : {9 * 20 + 10, 11 * 20 + 10, 10 * 20 + 9, 10 * 20 + 11}) points[n].value = 2.0;
+    const auto spike = measure::local_peak(points, 0.12, 2);
+    EXPECT_NEAR(spike.value, 3.8, 1e-13);
+    EXPECT_EQ(spike.raw, 11.0);
+    EXPECT_NEAR(spike.position[0], 1.05, 1e-15);
+    EXPECT_NEAR(spike.position[1], 1.05, 1e-15);
+    // A point of another body is not in the neighbourhood: alone in its body, its mean is itself.
+    points[10 * 20 + 11].body = 1;
+    points[10 * 20 + 11].value = 100.0;
+    EXPECT_NEAR(measure::local_peak(points, 0.12, 2).value, 100.0, 1e-12);
+    EXPECT_THROW(measure::local_peak(points, 0.0, 2), std::invalid_argument);
+    EXPECT_THROW(measure::local_peak(points, NAN, 2), std::invalid_argument);
+}
+
+TEST(FaceRoughness, ALinearTrendIsSmoothAndAnAlternationIsNot) {
+    const std::vector<double> x{3, 0, 2, 1, 4};  // any order: sorted by x inside
+    std::vector<double> linear, alternating;
+    for (double xi : x) {
+        linear.push_back(1.0 + 0.5 * xi);
+        alternating.push_back(1.0 + ((static_cast<int>(xi) % 2) ? 0.1 : -0.1));
+    }
+    EXPECT_NEAR(measure::face_roughness(x, linear), 0.0, 1e-15);
+    EXPECT_NEAR(measure::face_roughness(x, alternating), 0.2, 1e-15);  // a +-0.1 alternation: 2 x 0.1
+    EXPECT_EQ(measure::face_roughness(std::vector<double>{0, 1}, std::vector<double>{5, 7}), 0.0);
+}
+
+TEST(NodeDiameter, TheHoopStretchNeverShrinksTheSupport) {
+    // A ring that has doubled its radius at constant volume.
+    EXPECT_DOUBLE_EQ(node_diameter<Axisymmetric>(1.0, 0.0, 1.0, 2.0, 0), std::sqrt(0.5));  // Eq. 3: shrinks
+    EXPECT_DOUBLE_EQ(node_diameter<Axisymmetric>(1.0, 0.0, 1.0, 2.0, 1), 1.0);              // volume: unchanged
+    EXPECT_DOUBLE_EQ(node_diameter<Axisymmetric>(1.0, 0.0, 1.0, 2.0, 2), std::sqrt(2.0));   // hoop: grows
+    // Halved radius (a necking ring): Eq. 3 and the hoop rule agree.
+    EXPECT_DOUBLE_EQ(node_diameter<Axisymmetric>(1.0, 0.0, 2.0, 1.0, 2), node_diameter<Axisymmetric>(1.0, 0.0, 2.0, 1.0, 0));
+    // The volume enters every rule alike; other geometries have no hoop stretch.
+    EXPECT_DOUBLE_EQ(node_diameter<Axisymmetric>(1.0, 0.21, 1.0, 1.0, 2), 1.1);
+    EXPECT_DOUBLE_EQ(node_diameter<PlaneStrain>(1.0, 0.21, 1.0, 2.0, 2), 1.1);
+}
+
+// --- the element reference ----------------------------------------------------------------
+
+io::StudyReport series_of(const std::vector<double>& h, const std::vector<double>& length,
+                          const std::vector<double>& footprint) {
+    io::StudyReport r;
+    r.scene_name = "synthetic";
+    r.variants.push_back(io::parse_variant("elements:discretisation=elements"));
+    for (std::size_t k = 0; k < h.size(); ++k) {
+        io::StudyCase c;
+        c.variant = c.series = "elements";
+        c.cell_size = h[k];
+        c.finished = true;
+        c.metrics = {{"final_length", length[k]}, {"footprint_diameter", footprint[k]}};
+        r.cases.push_back(c);
+    }
+    return r;
+}
+
+TEST(ElementReference, RichardsonWhenTheOrderIsSoundTheFinestWhenSettledNoneOtherwise) {
+    // Length: f = 10 + h (first order) -> Richardson gives 10. Footprint: not monotone, within
+    // 0.5 % -> the finest value with the spread as its uncertainty.
+    const std::vector<double> h{0.4, 0.2, 0.1};
+    auto report = series_of(h, {10.4, 10.2, 10.1}, {5.00, 5.02, 5.01});
+    auto ref = io::reference_from_study(report, io::analyse_study(report), "elements", {});
+    ASSERT_TRUE(ref.values.count("final_length"));
+    EXPECT_EQ(ref.values["final_length"].kind, "richardson");
+    EXPECT_NEAR(ref.values["final_length"].value, 10.0, 1e-12);
+    EXPECT_NEAR(ref.values["final_length"].order, 1.0, 1e-12);
+    EXPECT_NEAR(ref.values["final_length"].uncertainty, 0.1, 1e-12);
+    ASSERT_TRUE(ref.values.count("footprint_diameter"));
+    EXPECT_EQ(ref.values["footprint_diameter"].kind, "finest");
+    EXPECT_EQ(ref.values["footprint_diameter"].value, 5.01);
+    EXPECT_NEAR(ref.values["footprint_diameter"].uncertainty, 0.02, 1e-12);
+    // A slow series (order 0.2) spread by 7 %: no reference, and the file says why.
+    const double r2 = std::pow(2.0, 0.2);
+    report = series_of(h, {10.0 + 3.0 * r2 * r2, 10.0 + 3.0 * r2, 13.0}, {5.0, 5.3, 4.7});
+    ref = io::reference_from_study(report, io::analyse_study(report), "elements", {});
+    EXPECT_FALSE(ref.values.count("final_length"));
+    ASSERT_TRUE(ref.missing.count("final_length"));
+    EXPECT_NE(ref.missing["final_length"].find("slowly"), std::string::npos) << ref.missing["final_length"];
+    EXPECT_FALSE(ref.values.count("footprint_diameter"));  // not monotone, 12 % apart
+    // Fewer than three resolutions: refused.
+    report.cases.pop_back();
+    EXPECT_THROW(io::reference_from_study(report, io::analyse_study(report), "elements", {}), InputError);
+}
+
+TEST(ElementReference, TheFileRoundTripsAndBadFilesAreNamed) {
+    const std::vector<double> h{0.4, 0.2, 0.1};
+    auto report = series_of(h, {10.4, 10.2, 10.1}, {5.00, 5.02, 5.01});
+    report.scene_file = "scenes/x.toml";
+    const auto ref = io::reference_from_study(report, io::analyse_study(report), "elements", {{0.0, 3.0}, {5.0, 2.0}, {10.0, 0.0}});
+    const fs::path dir = fs::temp_directory_path() / "gpa_test_element_reference";
+    fs::create_directories(dir);
+    io::write_element_reference(dir / "ref.toml", ref);
+    const auto back = io::read_element_reference(dir / "ref.toml");
+    EXPECT_EQ(back.scene, "synthetic");
+    EXPECT_EQ(back.variant, "elements:discretisation=elements");
+    EXPECT_EQ(back.cell_sizes.size(), 3u);
+    EXPECT_EQ(back.values.size(), ref.values.size());
+    EXPECT_NEAR(back.values.at("final_length").value, 10.0, 1e-9);
+    EXPECT_EQ(back.outline.size(), 3u);
+    EXPECT_FALSE(back.commit.empty());
+    EXPECT_EQ(back.date.size(), 10u);
+    // A missing file and a bad kind are named.
+    try {
+        io::read_element_reference(dir / "none.toml");
+        ADD_FAILURE() << "no error for a missing file";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("none.toml"), std::string::npos) << e.what();
+    }
+    {
+        std::ifstream in(dir / "ref.toml");
+        std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+        const auto at = text.find("kind = \"richardson\"");
+        ASSERT_NE(at, std::string::npos);
+        text.replace(at, 19, "kind = \"guess\"");
+        std::ofstream(dir / "bad.toml") << text;
+    }
+    try {
+        io::read_element_reference(dir / "bad.toml");
+        ADD_FAILURE() << "no error for a bad kind";
+    } catch (const InputError& e) {
+        const std::string what = e.what();
+        EXPECT_NE(what.find("bad.toml"), std::string::npos) << what;
+        EXPECT_NE(what.find("values.final_length.kind"), std::string::npos) << what;
+    }
+    fs::remove_all(dir);
+}
+
+TEST(ElementReference, OutlineDistanceAndRatios) {
+    // Two cylinders 10 mm tall, radii 4 and 4.5 mm: 0.5 mm apart at every height.
+    const std::vector<std::pair<double, double>> a{{0.0, 4.0}, {10.0, 4.0}}, b{{0.0, 4.5}, {10.0, 4.5}};
+    EXPECT_NEAR(io::outline_distance(a, b), 0.5, 1e-12);
+    EXPECT_NEAR(io::outline_distance(a, a), 0.0, 1e-15);
+    EXPECT_TRUE(std::isnan(io::outline_distance(a, {})));
+    // A cone against a cylinder: |r| differs by z / 10 on [0, 9.8]: mean 0.49.
+    const std::vector<std::pair<double, double>> cone{{0.0, 4.0}, {10.0, 5.0}};
+    EXPECT_NEAR(io::outline_distance(a, cone), 0.49, 1e-12);
+    io::ElementReference ref;
+    ref.values["final_length"].value = 20.0;
+    ref.values["plastic_work"].value = 100.0;
+    ref.outline = b;
+    const auto r = io::compare_with_reference({{"final_length", 19.0}, {"plastic_work", 102.0}, {"footprint_diameter", 5.0}}, a, ref);
+    EXPECT_DOUBLE_EQ(r.at("final_length"), 0.95);
+    EXPECT_DOUBLE_EQ(r.at("plastic_work"), 1.02);
+    EXPECT_FALSE(r.count("footprint_diameter"));  // the reference has none
+    EXPECT_NEAR(r.at("outline_distance"), 0.5, 1e-12);
+    // Peaks compare only over the same neighbourhood.
+    ref.values["peak_plastic_strain"].value = 2.0;
+    ref.peak_radius = 0.5e-3;
+    EXPECT_DOUBLE_EQ(io::compare_with_reference({{"peak_plastic_strain", 1.8}, {"peak_radius", 0.5e-3}}, a, ref).at("peak_plastic_strain"), 0.9);
+    EXPECT_FALSE(io::compare_with_reference({{"peak_plastic_strain", 1.8}, {"peak_radius", 0.7e-3}}, a, ref).count("peak_plastic_strain"));
+    EXPECT_FALSE(io::compare_with_reference({{"peak_plastic_strain", 1.8}}, a, ref).count("peak_plastic_strain"));
+}
+
+}  // namespace
+}  // namespace gpa
