@@ -91,7 +91,9 @@ void gradient_impl(const CompressedRows& lists, const GradientFields<G::dim>& f,
             for (NodeIndex j : lists.row(i)) {
                 const auto p = f.pairs.template pair<W>(i, j);
                 ok &= p.r > 0.0;
-                accumulate_gradient<D, full>(p, f.size_weight[j], (load<D>(f.velocity, j) - v_i).eval(), sums);
+                Vec<D> dv = load<D>(f.velocity, j) - v_i;
+                if (f.pairs.sliding(i, j)) dv = along_pair<D>(f.pairs.sliding_normal(i, j, p.l), dv);  // spec section 2
+                accumulate_gradient<D, full>(p, f.size_weight[j], dv, sums);
             }
             Mat<D> normalisation;
             if constexpr (full) {
@@ -185,10 +187,14 @@ void forces_impl(const CompressedRows& lists, const ScatterPlan& plan, const Bon
         }
         for (NodeIndex j : lists.row(i)) {
             const auto p = f.pairs.template pair<W>(i, j);
+            const bool sliding = f.pairs.sliding(i, j);  // spec section 2: one direction only
+            [[maybe_unused]] Vec<D> n;
+            if (sliding) n = f.pairs.sliding_normal(i, j, p.l);
             double q = 0.0;
             [[maybe_unused]] Vec<D> dv;
             if constexpr (with_bond_viscosity) {
                 dv = load<D>(f.velocity, j) - v_i;
+                if (sliding) dv = along_pair<D>(n, dv);
                 const double mu = bond_compression_rate(p, dv, bond.eps0);  // Eq. 38
                 q = bond_viscosity(mu, density, sound_speed, bond.linear, bond.quadratic);  // Eq. 37
             }
@@ -198,7 +204,8 @@ void forces_impl(const CompressedRows& lists, const ScatterPlan& plan, const Bon
             } else {
                 normalised_l = alpha.cwiseProduct(p.l);  // alpha_b l_b
             }
-            const Vec<D> force_on_j = pair_force(p, volume, f.size_weight[j], normalised_l, sigma, q);  // Eq. 21-22
+            Vec<D> force_on_j = pair_force(p, volume, f.size_weight[j], normalised_l, sigma, q);  // Eq. 21-22
+            if (sliding) force_on_j = along_pair<D>(n, force_on_j);
             if constexpr (with_bond_viscosity) {
                 if (f.largest_bond_viscosity) largest_q = std::max(largest_q, q);
             }
@@ -250,7 +257,8 @@ void stress_power_impl(const CompressedRows& lists, const ForceFields<G::dim>& f
             for (NodeIndex j : lists.row(i)) {
                 const auto p = f.pairs.template pair<W>(i, j);
                 const Vec<D> normalised_l = normalisation * p.l;
-                const Vec<D> dv = load<D>(velocity, j) - v_i;
+                Vec<D> dv = load<D>(velocity, j) - v_i;
+                if (f.pairs.sliding(i, j)) dv = along_pair<D>(f.pairs.sliding_normal(i, j, p.l), dv);  // spec section 2
                 sum += pair_force(p, volume, f.size_weight[j], normalised_l, sigma, 0.0).dot(dv);  // Eq. 21-22
                 divergence += p.R * f.size_weight[j] * p.inv_r * normalised_l.dot(dv);
             }

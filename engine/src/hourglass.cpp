@@ -38,8 +38,10 @@ void apply_hourglass_control(const CompressedRows& lists, const ScatterPlan& pla
         return v;
     };
     // The pairs the control acts on: a centre's real neighbours of its own body (ghosts and other
-    // bodies take no part).
-    const auto controlled_pair = [&](std::size_t i, NodeIndex j) { return j < real_count && f.body[j] == f.body[i]; };
+    // bodies take no part, nor do the pairs of a failed node when those separate).
+    const auto controlled_pair = [&](std::size_t i, NodeIndex j) {
+        return j < real_count && f.body[j] == f.body[i] && !(f.failed && (f.failed[i] || f.failed[j]));
+    };
     const auto centre = [&](std::size_t i) {
         f.power[i] = 0.0;
         if (i >= real_count) return;

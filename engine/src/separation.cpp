@@ -1,5 +1,7 @@
 #include "gpa/engine/separation.hpp"
 
+#include "gpa/engine/weights.hpp"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -50,7 +52,8 @@ bool pair_is_open(const NodeStore& nodes, std::size_t i, std::size_t j, bool fai
 }
 
 SeparationCounts remove_open_pairs(CompressedRows& lists, const NodeStore& nodes, std::size_t real_count,
-                                   bool failed_pairs_separate, double* closing_speed) {
+                                   bool failed_pairs_separate, double* closing_speed,
+                                   const std::array<double*, 3>& contact_direction, double influence_distance) {
     // One pass in place (the rows only shrink); most entries are a body and a failed flag compared.
     SeparationCounts counts;
     const int d = nodes.dim();
@@ -58,6 +61,8 @@ SeparationCounts remove_open_pairs(CompressedRows& lists, const NodeStore& nodes
     for (std::size_t i = 0; i < real_count; ++i) {
         const std::size_t end = lists.offsets[i + 1];
         double closing = 0.0;
+        bool touches_other_body = false;
+        const std::size_t row_out = out;
         for (std::size_t e = start; e < end; ++e) {
             const NodeIndex j = lists.indices[e];
             if (separable(nodes, i, j, failed_pairs_separate)) {
@@ -66,6 +71,7 @@ SeparationCounts remove_open_pairs(CompressedRows& lists, const NodeStore& nodes
                     continue;
                 }
                 ++counts.closed;
+                touches_other_body |= nodes.body[i] != nodes.body[j];
                 if (closing_speed) {
                     double dv_dx = 0.0, r2 = 0.0;
                     for (int c = 0; c < d; ++c) {
@@ -81,6 +87,30 @@ SeparationCounts remove_open_pairs(CompressedRows& lists, const NodeStore& nodes
         start = end;
         lists.offsets[i + 1] = out;
         if (closing_speed) closing_speed[i] = closing;
+        if (contact_direction[0]) {
+            // The outward direction of i's own body: minus the sum of the unit vectors to its kept
+            // neighbours of that body (ghosts included, so that an axis or a plane is no surface),
+            // wanted only where i touches another body.
+            std::array<double, 3> outward{0.0, 0.0, 0.0};
+            if (touches_other_body) {
+                for (std::size_t e = row_out; e < out; ++e) {
+                    const NodeIndex j = lists.indices[e];
+                    if (nodes.body[j] != nodes.body[i]) continue;
+                    std::array<double, 3> dx{0.0, 0.0, 0.0};
+                    double r2 = 0.0;
+                    for (int c = 0; c < d; ++c) {
+                        dx[c] = nodes.position[c][j] - nodes.position[c][i];
+                        r2 += dx[c] * dx[c];
+                    }
+                    if (!(r2 > 0.0)) continue;
+                    const double r = std::sqrt(r2);
+                    const double h = pair_smoothing_length(influence_distance, nodes.diameter[i], nodes.diameter[j]);
+                    const double weight = std::max(0.0, 1.0 - 0.5 * r / h);
+                    for (int c = 0; c < d; ++c) outward[c] -= weight * dx[c] / r;
+                }
+            }
+            for (int c = 0; c < d; ++c) contact_direction[c][i] = outward[c];
+        }
     }
     lists.indices.resize(out);
     return counts;

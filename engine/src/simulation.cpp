@@ -99,6 +99,43 @@ struct Simulation::Impl {
     // and solver.separate_failed; decided every step before the velocity gradient.
     bool with_separation = false;
     bool separate_failed = false;
+    bool sliding_contact = false;  // with_separation and solver.sliding_contact
+    // Per node (ghosts mirrored), the outward direction of its body where it touches another
+    // (separation.hpp), for the contact normals of sliding contact; made in neighbours().
+    std::array<std::vector<double>, 3> contact_direction;
+
+    // The pair fields of a phase, with sliding contact where the scene has it (fields.hpp).
+    template <int D>
+    PairFields<D> with_contact(PairFields<D> p) const {
+        p.sliding_contact = sliding_contact;
+        p.failed_pairs_separate = separate_failed;
+        p.failed = nodes.failed.data();
+        if (sliding_contact) {
+            for (int c = 0; c < D; ++c) p.contact_direction[c] = contact_direction[c].data();
+        }
+        return p;
+    }
+
+    // The open separable pairs out of the real rows (separation.hpp), with the closing speeds and
+    // contact directions of the step.
+    void separate_pairs() {
+        std::array<double*, 3> towards{};
+        if (sliding_contact) {
+            for (int c = 0; c < dim(); ++c) {
+                resize_with_slack(contact_direction[c], nodes.size());
+                towards[c] = contact_direction[c].data();
+            }
+        }
+        remove_open_pairs(lists, nodes, real, separate_failed, closing_speed.data(), towards, a());
+    }
+
+    // The ghosts' contact directions, mirrored from their sources once the ghost rows are in.
+    void mirror_contact_direction() {
+        if (!sliding_contact || ghosts.empty()) return;
+        ghosts.mirror_vector_field({contact_direction[0].data(), contact_direction[1].data(),
+                                    dim() == 3 ? contact_direction[2].data() : nullptr},
+                                   dim(), real);
+    }
     std::vector<double> closing_speed;     // per real node (separation.hpp); empty without separation
     ImpactFrame impact;                    // body_report.hpp, from the initial state
     std::vector<double> body_kinetic_half; // per body, like kinetic_half
@@ -277,6 +314,7 @@ void Simulation::Impl::setup() {
     index_regions();
     separate_failed = scene.solver.failure && scene.solver.separate_failed;
     with_separation = scene.bodies.size() > 1 || separate_failed;
+    sliding_contact = with_separation && scene.solver.sliding_contact;
     if (with_separation) closing_speed.assign(real, 0.0);
     lists_constant = !with_separation && ghosts.empty() && !needs_search(nodes, real) &&
                      std::none_of(body_mode.begin(), body_mode.end(),
@@ -526,27 +564,30 @@ void Simulation::Impl::neighbours() {
         filter_candidates(nodes, a(), candidates, lattice_entries, lists, keep_scratch);
         if (!ghosts.empty()) ghosts.remove_pairs_without_contact(lists, nodes, real);
         if (scene.solver.check_neighbour_lists) check_lists_against_search();
-        if (with_separation) remove_open_pairs(lists, nodes, real, separate_failed, closing_speed.data());
+        if (with_separation) separate_pairs();
         if (!ghosts.empty()) ghosts.append_ghost_rows(lists, real);
+        mirror_contact_direction();
         return;
     }
     ++searches;
     plan_due = true;
     if (ghosts.empty()) {
         find_neighbours(nodes, a(), real, lists, search_scratch);
-        if (with_separation) remove_open_pairs(lists, nodes, real, separate_failed, closing_speed.data());
+        if (with_separation) separate_pairs();
         return;
     }
     const CompressedRows& mirrored = ghosts.resolved_fixed_mirrors(nodes, real);
     find_neighbours(nodes, a(), real, lists, search_scratch, &mirrored);
     ghosts.remove_pairs_without_contact(lists, nodes, real);
-    if (with_separation) remove_open_pairs(lists, nodes, real, separate_failed, closing_speed.data());
+    if (with_separation) separate_pairs();
     ghosts.append_ghost_rows(lists, real);
+    mirror_contact_direction();
 }
 
 template <class G>
 void Simulation::Impl::gradient() {
     auto f = gradient_fields<G::dim>(nodes, a());
+    f.pairs = with_contact(f.pairs);
     f.alpha_limit = scene.solver.alpha_limit;
     f.full_normalisation = scene.solver.normalisation == Normalisation::MomentMatrix;
     f.allow_degenerate = true;  // a fragment that has lost its neighbours flies on (see fields.hpp)
@@ -673,6 +714,7 @@ void Simulation::Impl::time_step() {
 template <class G>
 void Simulation::Impl::forces() {
     auto f = force_fields<G::dim>(nodes, a());
+    f.pairs = with_contact(f.pairs);
     f.hoop_count = real;
     f.full_normalisation = scene.solver.normalisation == Normalisation::MomentMatrix;
     BondViscosityParameters bond{scene.solver.viscosity_linear, scene.solver.viscosity_quadratic, scene.solver.bond_viscosity_eps0};
@@ -687,8 +729,9 @@ void Simulation::Impl::forces() {
     compute_forces<G>(lists, plan, scene.solver.weight, with_bond ? &bond : nullptr, f, nodes.size());
     if (with_hourglass) {
         hourglass_power.assign(nodes.size(), 0.0);
-        apply_hourglass_control<G::dim>(lists, plan, hourglass_fields<G::dim>(nodes, scene.solver.switch_plastic_strain, hourglass_power.data()), real,
-                                        scene.solver.hourglass_coefficient);
+        auto h = hourglass_fields<G::dim>(nodes, scene.solver.switch_plastic_strain, hourglass_power.data());
+        if (sliding_contact && separate_failed) h.failed = nodes.failed.data();
+        apply_hourglass_control<G::dim>(lists, plan, h, real, scene.solver.hourglass_coefficient);
     }
     if (!ghosts.empty()) {
         const auto all = ghosts.normal_reactions(nodes, real);
@@ -733,6 +776,7 @@ void Simulation::Impl::book_stress_work(double dt_avg) {
     stress_power.resize(real);
     viscous_power.resize(real);
     auto f = force_fields<G::dim>(nodes, a());
+    f.pairs = with_contact(f.pairs);
     f.full_normalisation = scene.solver.normalisation == Normalisation::MomentMatrix;
     if (scene.solver.viscosity != ViscosityKind::Nodal) f.viscous_pressure = nullptr;  // as in forces()
     compute_stress_power<G>(lists, scene.solver.weight, f, mean, real, stress_power.data(), viscous_power.data());
@@ -746,6 +790,7 @@ void Simulation::Impl::book_stress_work(double dt_avg) {
         // The hourglass forces again (from the half-step velocities, as in forces()), their power
         // taken at the mean velocities: the kinetic energy they remove in this update.
         auto h = hourglass_fields<G::dim>(nodes, scene.solver.switch_plastic_strain, hourglass_power.data());
+        if (sliding_contact && separate_failed) h.failed = nodes.failed.data();
         for (int c = 0; c < G::dim; ++c) {
             h.velocity[c] = half_velocity[c].data();
             h.force[c] = nullptr;
@@ -828,7 +873,7 @@ void Simulation::Impl::smoothing() {
     if (!held_particles.empty()) o.held = held_bits.data();
     std::array<double*, G::dim> v{};
     for (int c = 0; c < G::dim; ++c) v[c] = nodes.velocity[c].data();
-    smooth_velocities<G>(lists, plan, scene.solver.weight, pair_fields<G::dim>(nodes, a()), real, o, v,
+    smooth_velocities<G>(lists, plan, scene.solver.weight, with_contact(pair_fields<G::dim>(nodes, a())), real, o, v,
                          nodes.mass.data(), nodes.pressure.data(), nodes.internal_energy.data(), smoothing_scratch);
     // The momentum that smoothing would have moved into held components (and that the free
     // nodes got instead) comes from the regions (smoothing.hpp).

@@ -23,7 +23,9 @@ double smooth_impl(const CompressedRows& lists, const ScatterPlan& plan, const P
             double weight_sum = 0.0, weighted_mass = 0.0;
             Vec<D> weighted_v = Vec<D>::Zero();
             for (NodeIndex j : lists.row(i)) {
-                if (j >= n) continue;  // ghosts take no part
+                // Ghosts take no part, nor do contacts and cracks (spec section 2, "[spec] Sliding
+                // contact": averaging velocities across them would be friction).
+                if (j >= n || pairs.sliding(i, j)) continue;
                 const double R = pairs.template pair<W>(i, j).R;
                 weight_sum += R;
                 weighted_mass += R * mass[j];
@@ -47,7 +49,7 @@ double smooth_impl(const CompressedRows& lists, const ScatterPlan& plan, const P
                                       const double* dv = &scratch.centre_change[D * i];
                                       for (int c = 0; c < D; ++c) scratch.total_change[D * i + c] += dv[c];
                                       for (NodeIndex j : lists.row(i)) {
-                                          if (j >= n) continue;
+                                          if (j >= n || pairs.sliding(i, j)) continue;
                                           const double f = -scratch.share[i] * pairs.template pair<W>(i, j).R;
                                           for (int c = 0; c < D; ++c) scratch.total_change[D * j + c] += f * dv[c];
                                       }

@@ -41,7 +41,7 @@ const std::vector<std::string_view> solver_keys{
     "connectivity", "switch_plastic_strain", "influence_distance", "weight",          "viscosity",
     "normalisation", "viscosity_linear", "viscosity_quadratic", "bond_viscosity_eps0", "hourglass_coefficient", "smoothing",     "smoothing_coefficient",
     "cfl",          "alpha_limit",           "max_time_step",      "time_step_growth", "failure",
-    "separate_failed", "energy_update", "node_diameter",
+    "separate_failed", "sliding_contact", "energy_update", "node_diameter",
     "scatter",      "reorder_interval",      "neighbour_skin",
 };
 const std::vector<std::string_view> stop_keys{"end_time", "kinetic_energy_fraction", "max_steps", "energy_error"};
@@ -464,6 +464,7 @@ SolverOptions read_solver(const Reporter& reporter, const toml::table& table) {
     if (const auto v = r.quantity("time_step_growth", D::Dimensionless)) s.time_step_growth = *v;
     if (const auto v = r.boolean("failure")) s.failure = *v;
     if (const auto v = r.boolean("separate_failed")) s.separate_failed = *v;
+    if (const auto v = r.boolean("sliding_contact")) s.sliding_contact = *v;
     if (const auto v = r.choice<EnergyUpdate>("energy_update", {{"compatible", EnergyUpdate::Compatible},
                                                                 {"point", EnergyUpdate::Point}})) {
         s.energy_update = *v;

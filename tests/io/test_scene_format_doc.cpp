@@ -105,6 +105,7 @@ TEST(SceneFormatDoc, DefaultsAreThoseOfSceneHpp) {
     expect_number(doc, "time_step_growth", s.time_step_growth);
     expect_word(doc, "failure", s.failure ? "true" : "false");
     expect_word(doc, "separate_failed", s.separate_failed ? "true" : "false");
+    expect_word(doc, "sliding_contact", s.sliding_contact ? "true" : "false");
     expect_word(doc, "energy_update", s.energy_update == EnergyUpdate::Compatible ? "\"compatible\"" : "\"point\"");
     expect_word(doc, "scatter", word(s.scatter));
     expect_number(doc, "reorder_interval", static_cast<double>(s.reorder_interval));
@@ -127,9 +128,9 @@ TEST(SceneFormatDoc, DefaultsAreThoseOfSceneHpp) {
     EXPECT_EQ(o.peak_radius, 0.0);
     expect_word(doc, "peak_radius", " twice the first body's spacing as written ");  // a cell without a `value`: as written
 
-    // 23 solver options, 4 stop criteria, 5 output options, and no row for an option that does
+    // 24 solver options, 4 stop criteria, 5 output options, and no row for an option that does
     // not exist.
-    EXPECT_EQ(doc.size(), 32u) << "rows in [solver], [stop] and [output] of docs/scene-format.md";
+    EXPECT_EQ(doc.size(), 33u) << "rows in [solver], [stop] and [output] of docs/scene-format.md";
 }
 
 }  // namespace

@@ -23,11 +23,43 @@ struct PairFields {
     const Connectivity* connectivity = nullptr;
     const std::int32_t* body = nullptr;
     double influence_distance = 1.0;
+    // Sliding contact (spec section 2, "[spec] Sliding contact"; docs/contact.md): with
+    // `sliding_contact`, a pair between two bodies, or (with failed_pairs_separate) one with a failed
+    // node, carries velocity differences and forces along one direction only (sliding_normal). Such a
+    // pair that is still in the lists is a closed separable pair (separation.hpp removed the open ones).
+    bool sliding_contact = false;
+    bool failed_pairs_separate = false;
+    const std::uint8_t* failed = nullptr;  // read with failed_pairs_separate
+    // Per node (ghosts included), the outward direction of its body where it touches another
+    // (separation.hpp); all null: every sliding pair acts along its line of centres.
+    std::array<const double*, D> contact_direction{};
 
     Vec<D> x(std::size_t i) const {
         Vec<D> p;
         for (int c = 0; c < D; ++c) p[c] = position[c][i];
         return p;
+    }
+
+    // A closed separable pair under sliding contact (see above). Symmetric in i and j.
+    bool sliding(std::size_t i, std::size_t j) const {
+        return sliding_contact && (body[i] != body[j] || (failed_pairs_separate && (failed[i] || failed[j])));
+    }
+
+    // The one direction a sliding pair acts along (spec section 2, "[spec] Sliding contact"). Across
+    // a contact between bodies: the normal of the contact surface, n = m_i - m_j normalised, m the
+    // outward directions of the two bodies at either end (minus the weighted sum of unit vectors to a
+    // node's own body's neighbours: on a flat face of a lattice exactly the face normal, whatever the
+    // other body's nodes do), turned to point from i towards j. Where the two give no clear direction
+    // (|m_i - m_j| < 1/4: nodes surrounded by their own bodies), and across cracks within a body:
+    // the line of centres l. n_ji = -n_ij bit for bit, so both ends project alike.
+    Vec<D> sliding_normal(std::size_t i, std::size_t j, const Vec<D>& l) const {
+        if (!contact_direction[0] || body[i] == body[j]) return l;
+        Vec<D> n;
+        for (int c = 0; c < D; ++c) n[c] = contact_direction[c][i] - contact_direction[c][j];
+        const double norm = n.norm();
+        if (!(norm >= 0.25)) return l;
+        n /= norm;
+        return n.dot(l) < 0.0 ? Vec<D>(-n) : n;
     }
 
     // Two fixed-connectivity nodes of one body form a lattice pair (spec section 2).

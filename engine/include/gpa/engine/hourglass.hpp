@@ -25,6 +25,9 @@ struct HourglassFields {
     const double* smallest_h = nullptr;   // h_i of the damping rate c_i / h_i
     const Connectivity* connectivity = nullptr;
     const std::int32_t* body = nullptr;
+    // Set when the pairs of failed nodes separate (separation.hpp): a crack is no pair of the
+    // control (its faces slide freely, spec section 2 "[spec] Sliding contact").
+    const std::uint8_t* failed = nullptr;
     const double* plastic_strain = nullptr;
     // Variable-connectivity centres are controlled while their equivalent plastic strain is below
     // this (the lattice regime, where the mode lives: see apply_hourglass_control); fixed ones always.

@@ -96,6 +96,16 @@ inline Vec<D> pair_force(const PairGeometry<D>& p, double volume_i, double size_
     return (-p.R * volume_i * size_weight_j * p.inv_r) * (sigma_i * normalised_l - bond_q * normalised_l);
 }
 
+// Spec section 2, "[spec] Sliding contact": a pair across a contact or a crack (a closed separable
+// pair) carries only the part of a velocity difference or a force along one unit direction n (the
+// contact normal, PairFields::sliding_normal), so the surfaces slide past each other without
+// friction (the failed material of a crack carries no shear either). The same projection in the
+// gradient and in the force keeps the energy identity of section 5: (P . n)(dv . n) on both sides.
+template <int D>
+inline Vec<D> along_pair(const Vec<D>& n, const Vec<D>& v) {
+    return n.dot(v) * n;
+}
+
 // Eq. 23 (with Eq. 32 read as "+ P_hoop", see spec section 5): the hoop stress of an
 // axisymmetric ring pulls it towards the axis, P_x(ii) += - sigma_theta V_i / x_i.
 inline double hoop_force(double sigma_theta, double volume, double radius) {

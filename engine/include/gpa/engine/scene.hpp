@@ -171,6 +171,10 @@ struct SolverOptions {
     // With failure: a pair with a failed node may open like a pair between bodies (separation.hpp),
     // so that a crack has free faces; false keeps such pairs like any other.
     bool separate_failed = true;
+    // Closed separable pairs (contacts between bodies, cracks) carry only normal velocity
+    // differences and forces: frictionless sliding (spec section 2, "[spec] Sliding contact";
+    // docs/contact.md). false: they act like any other pair, shear included (the surfaces stick).
+    bool sliding_contact = true;
     EnergyUpdate energy_update = EnergyUpdate::Compatible;
     ScatterScheme scatter = ScatterScheme::Slabs;
     std::size_t reorder_interval = 200;  // steps between locality reorderings (0 = never)

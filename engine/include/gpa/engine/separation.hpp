@@ -15,6 +15,7 @@
 // spatial discretisation's energy identity (spec section 5) exact. Opening a pair therefore does no
 // work of its own: there is no energy to book.
 
+#include <array>
 #include <cstddef>
 
 #include "gpa/engine/compressed_rows.hpp"
@@ -36,8 +37,15 @@ struct SeparationCounts {
 // by up to the impact speed within one spacing, a discontinuity that the viscosity has not yet seen
 // (Q = 0 before the first compression), so the time step adds it to the signal speed (spec section
 // 11, "[spec] Closing interfaces").
+// contact_direction (optional, D arrays of one value per real node): for a node with a closed
+// partner in another body, the outward direction of its own body there, -sum_j (1 - r_ij / 2 h_ij) l_ij
+// over its kept neighbours j of its own body, h_ij from `influence_distance` (Eq. 2; the weight makes
+// a neighbour at the edge of the support count for nothing, so that round-off in which of those are
+// listed does not tilt it); 0 for other nodes. A contact pair's sliding direction is formed from the
+// two ends' (PairFields::sliding_normal).
 SeparationCounts remove_open_pairs(CompressedRows& lists, const NodeStore& nodes, std::size_t real_count,
-                                   bool failed_pairs_separate, double* closing_speed = nullptr);
+                                   bool failed_pairs_separate, double* closing_speed = nullptr,
+                                   const std::array<double*, 3>& contact_direction = {}, double influence_distance = 1.0);
 
 // The test of one pair, for tests and diagnostics: true if (i, j) is separable and open.
 bool pair_is_open(const NodeStore& nodes, std::size_t i, std::size_t j, bool failed_pairs_separate);
