@@ -2,8 +2,9 @@
 # The test suite under the address and undefined-behaviour sanitizers, then the libFuzzer target
 # on the scene reader for a bounded time. One clang build (build-asan) serves both.
 # Usage: scripts/sanitize.sh [FUZZ_SECONDS]   (default 60; 0 skips the fuzzing)
-# The tests labelled `slow` (long physics runs) and `install` (a consumer built with the system
-# compiler against these libraries) are left out, and so are the long accuracy runs of gpa_tests. Needs clang and libFuzzer (scripts/install-deps.sh).
+# The tests labelled `slow` (long physics runs: not even built here) and `install` (a consumer built
+# with the system compiler against these libraries) are left out, and so are the long accuracy runs
+# of gpa_tests and the study programs of tools/. Needs clang and libFuzzer (scripts/install-deps.sh).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 fuzz_seconds=${1:-60}
@@ -16,7 +17,8 @@ mkdir -p "$build"
 cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_FLAGS_RELEASE="-O1 -gline-tables-only" \
   -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ \
   -DCMAKE_CXX_FLAGS="$flags" -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined" \
-  -DGPA_BUILD_BENCHMARKS=OFF -DGPA_BUILD_FUZZERS=ON > "$build/configure.log" || { cat "$build/configure.log"; exit 1; }
+  -DGPA_BUILD_BENCHMARKS=OFF -DGPA_BUILD_SLOW_TESTS=OFF -DGPA_BUILD_TOOLS=OFF -DGPA_BUILD_FUZZERS=ON \
+  > "$build/configure.log" || { cat "$build/configure.log"; exit 1; }
 cmake --build "$build" -j"$jobs"
 
 # Reports inside third-party headers only, each explained in the file.
