@@ -595,7 +595,10 @@ Picture render_snapshot(const LoadedSnapshot& snapshot, GeometryKind geometry, c
     if (options.region) {
         // Keep what reaches into the window (mirrored images included: they are then counted as
         // drawn nodes of their own).
-        const auto [left, right, bottom, top] = *options.region;
+        // Plain copies, not a structured binding: lambdas below capture them (C++20 as clang 14 reads it
+        // does not allow capturing structured bindings).
+        const double left = (*options.region)[0], right = (*options.region)[1], bottom = (*options.region)[2],
+                     top = (*options.region)[3];
         if (!(left < right) || !(bottom < top)) {
             throw InputError(fmt::format("region {} to {} by {} to {}: each range must end above where it starts",
                                          format_quantity(left, "m"), format_quantity(right, "m"), format_quantity(bottom, "m"),
