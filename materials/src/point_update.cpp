@@ -113,26 +113,35 @@ PointResult update_point(const Material& m, PointState& state, const PointIncrem
     const double deviatoric_work = inc.dt / rho_mid * (0.5 * (s_old + s_new)).cwiseProduct(d_dev).sum();
 
     const detail::EosTerms eos = detail::eos_terms(m.eos, m.density, rho_new);
-    // e_new = known - (a + b e_new) dv / 2  =>  e_new (1 + b dv / 2) = known - a dv / 2.
-    const double known = state.specific_internal_energy + deviatoric_work - (0.5 * state.pressure + q_mid) * dv;
-    const double denominator = 1.0 + 0.5 * eos.b * dv;
-    // 1 + Gamma0 rho0 dv / 2 falls to 1/2 only if one step shrinks the specific volume by
-    // v0 / Gamma0 (half the initial specific volume for Gamma0 = 2): no explicit step does that.
-    if (!(denominator > 0.5)) {
-        throw std::domain_error(fmt::format(
-            "point update: compression {} -> {} kg/m^3 in one step is too large for the energy solve "
-            "(1 + b dv / 2 = {})",
-            rho_old, rho_new, denominator));
-    }
-    double energy = (known - 0.5 * eos.a * dv) / denominator;
-    double pressure = eos.a + eos.b * energy;
+    double energy = state.specific_internal_energy;
+    double pressure = 0.0;
     if (inc.energy_booked_by_caller) {
-        energy = state.specific_internal_energy;
+        // The caller books this step's work into e (the compatible update, docs/energy.md): the
+        // pressure follows from the EOS at the new density and the energy as it stands; no energy
+        // equation is solved here, so no step is too large for one.
         pressure = eos.a + eos.b * energy;
         if (state.failed && pressure < 0.0) pressure = 0.0;
-    } else if (state.failed && pressure < 0.0) {
-        pressure = 0.0;
-        energy = known;
+    } else {
+        // e_new = known - (a + b e_new) dv / 2  =>  e_new (1 + b dv / 2) = known - a dv / 2.
+        const double known = state.specific_internal_energy + deviatoric_work - (0.5 * state.pressure + q_mid) * dv;
+        const double denominator = 1.0 + 0.5 * eos.b * dv;
+        // b = Gamma0 rho0 (Mie-Grueneisen), so 1 + b dv / 2 falls to 1/2 when one step shrinks the
+        // specific volume by v0 / Gamma0: half the initial specific volume for Gamma0 = 2, out of
+        // reach of an explicit step at about the initial density, but only a sixth of the volume of
+        // a failed node expanded to a third of it (a fragment cloud of a hypervelocity impact).
+        // The trapezoidal solve is then no longer a fair approximation: refuse it, naming the step.
+        if (!(denominator > 0.5)) {
+            throw std::domain_error(fmt::format(
+                "point update: compression {} -> {} kg/m^3 in one step is too large for the energy solve "
+                "(1 + b dv / 2 = {}); the compatible energy update (solver.energy_update) has no such limit",
+                rho_old, rho_new, denominator));
+        }
+        energy = (known - 0.5 * eos.a * dv) / denominator;
+        pressure = eos.a + eos.b * energy;
+        if (state.failed && pressure < 0.0) {
+            pressure = 0.0;
+            energy = known;
+        }
     }
 
     // 5-6. Plastic work and temperature.

@@ -3,6 +3,7 @@
 // the energy equation (closed loops, the exact linear solve, the Rankine-Hugoniot jump) and the
 // sound speed.
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -302,6 +303,46 @@ TEST(Energy, MieGruneisenExactSolveMakesEnergyConsistentWithPressure) {
         q_old = q_new;
     }
     EXPECT_GT(p.density / m.density - 1.0, 0.2);  // well into the nonlinear part of the Hugoniot
+}
+
+TEST(Energy, AFailedExpandedPointCompressedHardInOneStepNeedsNoEnergySolveWhenTheCallerBooksTheWork) {
+    // A failed node of a fragment cloud (hypervelocity impact, 0.2 mm, all-variable) expanded to a
+    // third of its density and compressed by 29 % in one step: 1 + Gamma0 rho0 dv / 2 = 0.32, so the
+    // point update's own trapezoidal energy solve is refused, naming the step; with the compatible
+    // update (the caller books the work) there is no solve, and the update must go through with
+    // P = EOS(rho_new, e) clamped at zero and e left for the caller (it used to throw the same
+    // refusal and stop the run).
+    const Material m = test::copper();
+    PointState failed;
+    failed.failed = true;
+    failed.damage = 1.0;
+    failed.specific_internal_energy = 2e5;  // J/kg, heated by the impact
+    PointIncrement inc;
+    inc.dt = 1.6e-9;
+    inc.density_old = m.density / 3.0;
+    inc.density_new = 1.29 * inc.density_old;
+    inc.velocity_gradient = isotropic(inc.density_old, inc.density_new, inc.dt);
+    inc.failure_enabled = true;
+    ASSERT_LT(1.0 + 0.5 * 2.02 * m.density * (1.0 / inc.density_new - 1.0 / inc.density_old), 0.5);
+
+    PointState by_point = failed;
+    try {
+        update_point(m, by_point, inc);
+        ADD_FAILURE() << "the point update's own energy solve must refuse this step";
+    } catch (const std::domain_error& e) {
+        EXPECT_NE(std::string(e.what()).find("too large for the energy solve"), std::string::npos) << e.what();
+    }
+
+    inc.energy_booked_by_caller = true;
+    PointState by_caller = failed;
+    const PointResult r = update_point(m, by_caller, inc);
+    const EosResult eos = evaluate_eos(m.eos, m.density, inc.density_new, failed.specific_internal_energy);
+    EXPECT_EQ(by_caller.specific_internal_energy, failed.specific_internal_energy);  // the caller's to change
+    const double expected = std::max(eos.pressure, 0.0);  // no tension once failed
+    EXPECT_NEAR(by_caller.pressure, expected, kRoundOff * std::abs(eos.pressure));
+    EXPECT_TRUE(std::isfinite(r.sound_speed));
+    EXPECT_GT(r.sound_speed, 0.0);
+    EXPECT_TRUE(by_caller.failed);
 }
 
 TEST(SoundSpeed, ReferenceAndCompressedStates) {
