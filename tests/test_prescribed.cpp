@@ -223,7 +223,9 @@ TEST(PrescribedVelocity, ARigidMotionKeepsTheEnergyBooksClosedToRoundOff) {
             ASSERT_GT(t.regions[0].work, 0.0);
             // (At t^n the kinetic energy is the mean of the half steps; with the point update the
             // work is taken at t^n too.)
-            if (update == EnergyUpdate::Point) EXPECT_NEAR(t.kinetic_energy, t.regions[0].work, 1e-13 * t.regions[0].work) << "step " << k + 1;
+            if (update == EnergyUpdate::Point) {
+                EXPECT_NEAR(t.kinetic_energy, t.regions[0].work, 1e-13 * t.regions[0].work) << "step " << k + 1;
+            }
             EXPECT_EQ(t.internal_energy, 0.0);
             EXPECT_LT(std::abs(t.energy_error), 1e-13);
         }

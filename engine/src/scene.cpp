@@ -296,6 +296,9 @@ void check_solver(const SolverOptions& s) {
     if (!(s.max_time_step > 0.0)) {
         fail(fmt::format("solver.max_time_step = {} must be a positive time (s), or infinity for no limit", s.max_time_step));
     }
+    if (!(s.max_volume_change >= 0.0 && s.max_volume_change < 1.0)) {
+        fail(fmt::format("solver.max_volume_change = {} must be a fraction from 0 (no limit) to below 1", s.max_volume_change));
+    }
     if (!(s.time_step_growth >= 1.0 && finite(s.time_step_growth))) {
         fail(fmt::format("solver.time_step_growth = {} must be a finite ratio >= 1", s.time_step_growth));
     }

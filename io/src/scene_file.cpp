@@ -40,7 +40,7 @@ const std::vector<std::string_view> region_keys{"box", "above", "below", "beyond
 const std::vector<std::string_view> solver_keys{
     "connectivity", "switch_plastic_strain", "influence_distance", "weight",          "viscosity",
     "normalisation", "viscosity_linear", "viscosity_quadratic", "bond_viscosity_eps0", "hourglass_coefficient", "smoothing",     "smoothing_coefficient",
-    "cfl",          "alpha_limit",           "max_time_step",      "time_step_growth", "failure",
+    "cfl",          "alpha_limit",           "max_time_step",      "time_step_growth", "max_volume_change", "failure",
     "separate_failed", "sliding_contact", "energy_update", "node_diameter",
     "scatter",      "reorder_interval",      "neighbour_skin",
 };
@@ -462,6 +462,7 @@ SolverOptions read_solver(const Reporter& reporter, const toml::table& table) {
     if (const auto v = r.quantity("neighbour_skin", D::Dimensionless)) s.neighbour_skin = *v;
     if (const auto v = r.quantity("max_time_step", D::Time, Limit::PositiveOrInfinite)) s.max_time_step = *v;
     if (const auto v = r.quantity("time_step_growth", D::Dimensionless)) s.time_step_growth = *v;
+    if (const auto v = r.quantity("max_volume_change", D::Dimensionless)) s.max_volume_change = *v;
     if (const auto v = r.boolean("failure")) s.failure = *v;
     if (const auto v = r.boolean("separate_failed")) s.separate_failed = *v;
     if (const auto v = r.boolean("sliding_contact")) s.sliding_contact = *v;

@@ -130,7 +130,7 @@ TEST(SceneFormatDoc, DefaultsAreThoseOfSceneHpp) {
 
     // 24 solver options, 4 stop criteria, 5 output options, and no row for an option that does
     // not exist.
-    EXPECT_EQ(doc.size(), 33u) << "rows in [solver], [stop] and [output] of docs/scene-format.md";
+    EXPECT_EQ(doc.size(), 34u) << "rows in [solver], [stop] and [output] of docs/scene-format.md";
 }
 
 }  // namespace

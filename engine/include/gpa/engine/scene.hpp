@@ -167,6 +167,11 @@ struct SolverOptions {
     double alpha_limit = 3.0;
     double max_time_step = std::numeric_limits<double>::infinity();  // s
     double time_step_growth = 1.1;       // largest ratio of one step to the previous
+    // Largest fraction by which one step may change a node's volume, dt <= this / |eps_v_dot|
+    // (compression always, expansion while the pressure is positive; spec section 11): a node
+    // squeezed by a large fraction in one step gets its pressure a step late, and the work booked
+    // on the way in falls short of the work given back on the way out (0 = no limit).
+    double max_volume_change = 0.1;
     bool failure = false;                // apply the materials' failure models (J-C damage, spall)
     // With failure: a pair with a failed node may open like a pair between bodies (separation.hpp),
     // so that a crack has free faces; false keeps such pairs like any other.
