@@ -373,6 +373,18 @@ TEST(RubberRings, TheyBounceApartWholeWithoutPassingIntoEachOther) {
     EXPECT_LT(r.worst_energy, 1e-11);
 }
 
+// The paper's two smoothing modes on the bar at the scene's resolution: smoothing in tension (the
+// scene) against smoothing everywhere (docs/tension.md, "Smoothing mode").
+//   build/tests/gpa_slow_tests --gtest_also_run_disabled_tests --gtest_filter='*SmoothingModes*'
+TEST(TensionStudy, DISABLED_SmoothingModes) {
+    for (const SmoothingMode mode : {SmoothingMode::Tension, SmoothingMode::Everywhere}) {
+        Scene s = scene_file("tension-bar-4340.toml");
+        s.solver.smoothing = mode;
+        const BarRun r = pull(s, false);
+        print(mode == SmoothingMode::Tension ? "smoothing in tension" : "smoothing everywhere", r, 2.0 * s.bodies[0].radius);
+    }
+}
+
 // The same bar with explicit finite elements (docs/elements.md), the same material model without
 // smoothing or hourglass terms: the neck diameter at each tenth of the elongation up to 0.6, 2 min over the
 // mesh's levels (initial z, grips left out) of the level's largest x.
