@@ -59,13 +59,14 @@ LatticeBlock body_lattice(const Scene& scene, std::size_t index) {
             }
             case ShapeKind::Sphere: {
                 const auto [n, s] = fit(axisymmetric ? b.radius : 2.0 * b.radius, dx, b.name, "radius");
-                const double r = b.radius, cx = axisymmetric ? 0.0 : o[0], cz = o[1];
+                const double r = b.radius, r_in = b.inner_radius, cx = axisymmetric ? 0.0 : o[0], cz = o[1];
                 const std::int64_t nz = axisymmetric ? 2 * n : n;
                 block.origin = {axisymmetric ? 0.0 : cx - r, cz - r, 0.0};
                 block.spacing = {s, s, 1.0};
                 block.last = {n, nz, 1};
                 block.inside = [=](const std::array<double, 3>& p) {
-                    return (p[0] - cx) * (p[0] - cx) + (p[1] - cz) * (p[1] - cz) < r * r;
+                    const double q = (p[0] - cx) * (p[0] - cx) + (p[1] - cz) * (p[1] - cz);
+                    return q < r * r && q >= r_in * r_in;
                 };
                 break;
             }
@@ -98,7 +99,7 @@ LatticeBlock body_lattice(const Scene& scene, std::size_t index) {
             }
             case ShapeKind::Sphere: {
                 const auto [n, s] = fit(2.0 * b.radius, dx, b.name, "diameter");
-                const double r = b.radius;
+                const double r = b.radius, r_in = b.inner_radius;
                 const auto c = o;
                 block.origin = {c[0] - r, c[1] - r, c[2] - r};
                 block.spacing = {s, s, s};
@@ -106,7 +107,7 @@ LatticeBlock body_lattice(const Scene& scene, std::size_t index) {
                 block.inside = [=](const std::array<double, 3>& p) {
                     double q = 0.0;
                     for (int k = 0; k < 3; ++k) q += (p[k] - c[k]) * (p[k] - c[k]);
-                    return q < r * r;
+                    return q < r * r && q >= r_in * r_in;
                 };
                 break;
             }

@@ -143,6 +143,24 @@ void check_body(const Scene& scene, const BodySpec& b, std::size_t i) {
             fail(fmt::format("{}.origin: an axisymmetric {} lies on the axis, so its origin x must be 0 (is {} m)", label,
                              name_of(b.shape), b.origin[0]));
         }
+        if (b.inner_radius != 0.0) {
+            if (b.shape != ShapeKind::Sphere) {
+                fail(fmt::format("{}.inner_radius applies to a sphere only (a ring in plane strain), not a {}", label,
+                                 name_of(b.shape)));
+            }
+            if (!(b.inner_radius > 0.0 && finite(b.inner_radius))) {
+                fail(fmt::format("{}.inner_radius = {} must be a length >= 0 (m; 0 = a solid sphere)", label, b.inner_radius));
+            }
+            if (!(b.inner_radius < b.radius)) {
+                fail(fmt::format("{}.inner_radius = {} m must be less than its radius ({} m): nothing would be left of the {}",
+                                 label, b.inner_radius, b.radius, g == GeometryKind::PlaneStrain ? "ring" : "shell"));
+            }
+            if (b.radius - b.inner_radius < 2.0 * b.spacing * (1.0 - 1e-12)) {
+                fail(fmt::format("{}: spacing {} m puts fewer than 2 nodes across its wall ({} m from inner_radius to "
+                                 "radius); use a spacing of at most {} m",
+                                 label, b.spacing, b.radius - b.inner_radius, 0.5 * (b.radius - b.inner_radius)));
+            }
+        }
     } else {
         for (int k = 0; k < dim; ++k) {
             const double s = b.size[static_cast<std::size_t>(k)];
@@ -277,6 +295,9 @@ void check_solver(const SolverOptions& s) {
     if (s.smoothing != SmoothingMode::Off && s.smoothing != SmoothingMode::Everywhere &&
         s.smoothing != SmoothingMode::Tension) {
         fail("solver.smoothing: unknown smoothing mode");
+    }
+    if (!(s.hourglass_stiffness >= 0.0 && s.hourglass_stiffness <= 1.0)) {
+        fail(fmt::format("solver.hourglass_stiffness = {} is outside [0, 1]", s.hourglass_stiffness));
     }
     if (!(s.hourglass_coefficient >= 0.0 && s.hourglass_coefficient <= 1.0)) {
         fail(fmt::format("solver.hourglass_coefficient = {} is outside [0, 1]", s.hourglass_coefficient));

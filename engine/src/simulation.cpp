@@ -94,7 +94,7 @@ struct Simulation::Impl {
     ScatterPlan plan;
     SmoothingScratch smoothing_scratch;
     std::vector<double> bond_power;
-    bool with_hourglass = false;         // C_hg > 0
+    bool with_hourglass = false;         // C_hg > 0 or C_hs > 0
     // Separable pairs (separation.hpp): between bodies, and through failed nodes when failure is on
     // and solver.separate_failed; decided every step before the velocity gradient.
     bool with_separation = false;
@@ -141,8 +141,10 @@ struct Simulation::Impl {
     std::vector<double> body_kinetic_half; // per body, like kinetic_half
     bool any_automatic = false;          // some body switches fixed nodes to variable
     std::vector<double> hourglass_power; // per centre, the power of its hourglass-control forces
+    std::vector<double> hourglass_stiffness_power; // per centre, the power of its hourglass-stiffness forces (C_hs > 0)
     std::vector<double> cell_ratio;      // per node, its smallest lattice-cell volume ratio (lattice_check.hpp)
     double hourglass_work = 0.0;
+    double hourglass_energy = 0.0;  // work of the hourglass stiffness, booked as internal energy
     std::vector<double> largest_bond_q;  // per centre, the largest Q_ij of its pairs (for the time step)
     bool failed = false;                 // a phase threw: the state is half-updated
     std::unique_ptr<PhaseGraph> graph;
@@ -320,7 +322,7 @@ void Simulation::Impl::setup() {
                      std::none_of(body_mode.begin(), body_mode.end(),
                                   [](ConnectivityMode m) { return m == ConnectivityMode::Automatic; });
     with_skin = scene.solver.neighbour_skin > 0.0 && !lists_constant;
-    with_hourglass = scene.solver.hourglass_coefficient > 0.0;
+    with_hourglass = scene.solver.hourglass_coefficient > 0.0 || scene.solver.hourglass_stiffness > 0.0;
     compatible_energy = scene.solver.energy_update == EnergyUpdate::Compatible;
     any_automatic = std::any_of(body_mode.begin(), body_mode.end(), [](ConnectivityMode m) { return m == ConnectivityMode::Automatic; });
 
@@ -743,7 +745,9 @@ void Simulation::Impl::forces() {
     compute_forces<G>(lists, plan, scene.solver.weight, with_bond ? &bond : nullptr, f, nodes.size());
     if (with_hourglass) {
         hourglass_power.assign(nodes.size(), 0.0);
-        auto h = hourglass_fields<G::dim>(nodes, scene.solver.switch_plastic_strain, hourglass_power.data());
+        hourglass_stiffness_power.assign(nodes.size(), 0.0);
+        auto h = hourglass_fields<G::dim>(nodes, scene.solver.switch_plastic_strain, hourglass_power.data(),
+                                          scene.solver.hourglass_stiffness, hourglass_stiffness_power.data());
         if (sliding_contact && separate_failed) h.failed = nodes.failed.data();
         apply_hourglass_control<G::dim>(lists, plan, h, real, scene.solver.hourglass_coefficient);
     }
@@ -803,7 +807,8 @@ void Simulation::Impl::book_stress_work(double dt_avg) {
     if (with_hourglass) {
         // The hourglass forces again (from the half-step velocities, as in forces()), their power
         // taken at the mean velocities: the kinetic energy they remove in this update.
-        auto h = hourglass_fields<G::dim>(nodes, scene.solver.switch_plastic_strain, hourglass_power.data());
+        auto h = hourglass_fields<G::dim>(nodes, scene.solver.switch_plastic_strain, hourglass_power.data(),
+                                          scene.solver.hourglass_stiffness, hourglass_stiffness_power.data());
         if (sliding_contact && separate_failed) h.failed = nodes.failed.data();
         for (int c = 0; c < G::dim; ++c) {
             h.velocity[c] = half_velocity[c].data();
@@ -865,6 +870,21 @@ void Simulation::Impl::integrate(double dt_avg) {
                 return sum;
             },
             [](double x, double y) { return x + y; });
+        if (scene.solver.hourglass_stiffness > 0.0) {
+            // The stiffness forces store energy rather than dissipate it: their work is internal
+            // energy of the centre (kernels.hpp, hourglass_stiffness), not viscous work.
+            hourglass_energy += tbb::parallel_deterministic_reduce(
+                tbb::blocked_range<std::size_t>(0, real, reduce_grain), 0.0,
+                [&](const tbb::blocked_range<std::size_t>& r, double sum) {
+                    for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                        const double stored = -hourglass_stiffness_power[i] * dt_avg;
+                        nodes.internal_energy[i] += stored / nodes.mass[i];
+                        sum += stored;
+                    }
+                    return sum;
+                },
+                [](double x, double y) { return x + y; });
+        }
     }
 }
 
@@ -1112,6 +1132,7 @@ void Simulation::Impl::sum_totals() {
     totals.plastic_work = all.plastic;
     totals.viscous_work = all.viscous;
     totals.hourglass_work = hourglass_work;
+    totals.hourglass_energy = hourglass_energy;
     // The regions' work, taken at the instant of the energy balance's kinetic energy. With the
     // compatible energy update (particle bodies) that is the half step ahead, v^{n+3/2}: the work of
     // every velocity update so far, like the impulse. Otherwise the balance takes the kinetic energy
@@ -1635,6 +1656,7 @@ void Simulation::Impl::write_state(StateWriter& out) const {
     out.value<double>(kinetic_half);
     out.value<double>(boundary_work);
     out.value<double>(hourglass_work);
+    out.value<double>(hourglass_energy);
     out.array(body_kinetic_half);
     out.value<std::uint64_t>(totals.bodies.size());
     for (const auto& b : totals.bodies) out.value<double>(b.kinetic_energy);
@@ -1654,7 +1676,7 @@ void Simulation::Impl::write_state(StateWriter& out) const {
     const Totals& t = totals;
     for (const double v : {t.time, t.time_step, t.kinetic_energy, t.internal_energy, t.plastic_work, t.viscous_work,
                            t.boundary_work, t.initial_kinetic_energy, t.initial_energy, t.energy_error, t.momentum[0],
-                           t.momentum[1], t.momentum[2], t.length, t.footprint_diameter, t.hourglass_work, t.energy_given}) {
+                           t.momentum[1], t.momentum[2], t.length, t.footprint_diameter, t.hourglass_work, t.hourglass_energy, t.energy_given}) {
         out.value<double>(v);
     }
     for (const std::size_t v : {t.step, t.real_nodes, t.ghost_nodes, t.variable_nodes, t.failed_nodes, t.pairs,
@@ -1716,6 +1738,7 @@ void Simulation::Impl::read_state(StateReader& in) {
     kinetic_half = in.value<double>();
     boundary_work = in.value<double>();
     hourglass_work = in.value<double>();
+    hourglass_energy = in.value<double>();
     in.array(body_kinetic_half);
     if (body_kinetic_half.size() != scene.bodies.size()) in.fail("its bodies are not the scene's");
     std::vector<double> body_kinetic(static_cast<std::size_t>(in.value<std::uint64_t>()));
@@ -1740,7 +1763,7 @@ void Simulation::Impl::read_state(StateReader& in) {
     Totals& t = totals;
     for (double* v : {&t.time, &t.time_step, &t.kinetic_energy, &t.internal_energy, &t.plastic_work, &t.viscous_work,
                       &t.boundary_work, &t.initial_kinetic_energy, &t.initial_energy, &t.energy_error, &t.momentum[0],
-                      &t.momentum[1], &t.momentum[2], &t.length, &t.footprint_diameter, &t.hourglass_work, &t.energy_given}) {
+                      &t.momentum[1], &t.momentum[2], &t.length, &t.footprint_diameter, &t.hourglass_work, &t.hourglass_energy, &t.energy_given}) {
         *v = in.value<double>();
     }
     for (std::size_t* v : {&t.step, &t.real_nodes, &t.ghost_nodes, &t.variable_nodes, &t.failed_nodes, &t.pairs,

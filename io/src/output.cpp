@@ -104,7 +104,7 @@ std::string body_values(const Totals& t, int dim) {
 std::string history_header(const Totals& first, int dim) {
     std::string header =
         "time_s,dt_s,step,kinetic_energy_J,internal_energy_J,plastic_work_J,viscous_work_J,boundary_work_J,"
-        "total_energy_error,hourglass_work_J";
+        "total_energy_error,hourglass_work_J,hourglass_energy_J";
     header += dim == 3 ? ",momentum_x_kg_m_s,momentum_y_kg_m_s,momentum_z_kg_m_s" : ",momentum_x_kg_m_s,momentum_z_kg_m_s";
     header += ",length_m,footprint_diameter_m,base_height_m";
     // Local peaks (measure.hpp): the neighbourhood peak, where it is, the largest single value.
@@ -191,9 +191,9 @@ void HistoryWriter::append(const std::string& text) {
 }
 
 void HistoryWriter::write(const Totals& t) {
-    std::string row = fmt::format("{:.9e},{:.6e},{},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.6e},{:.9e}", t.time, t.time_step,
+    std::string row = fmt::format("{:.9e},{:.6e},{},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.6e},{:.9e},{:.9e}", t.time, t.time_step,
                                   t.step, t.kinetic_energy, t.internal_energy, t.plastic_work, t.viscous_work,
-                                  t.boundary_work, t.energy_error, t.hourglass_work);
+                                  t.boundary_work, t.energy_error, t.hourglass_work, t.hourglass_energy);
     for (int c = 0; c < dim_; ++c) row += fmt::format(",{:.9e}", t.momentum[c]);
     row += fmt::format(",{:.9e},{:.9e},{:.9e}", t.length, t.footprint_diameter, t.base_height);
     for (const auto* peak : {&t.local.plastic_strain, &t.local.temperature}) {
@@ -398,9 +398,9 @@ void write_summary(const fs::path& file, const Simulation& sim, const RunSummary
                                    json_number(t.local.face_roughness), t.local.face_points));
     }
     field("energy", fmt::format("{{\"initial_J\": {}, \"kinetic_J\": {}, \"internal_J\": {}, \"plastic_work_J\": {}, "
-                                "\"viscous_work_J\": {}, \"hourglass_work_J\": {}, \"boundary_work_J\": {}, \"given_J\": {}, \"relative_error\": {}}}",
+                                "\"viscous_work_J\": {}, \"hourglass_work_J\": {}, \"hourglass_energy_J\": {}, \"boundary_work_J\": {}, \"given_J\": {}, \"relative_error\": {}}}",
                                 json_number(t.initial_energy), json_number(t.kinetic_energy), json_number(t.internal_energy),
-                                json_number(t.plastic_work), json_number(t.viscous_work), json_number(t.hourglass_work),
+                                json_number(t.plastic_work), json_number(t.viscous_work), json_number(t.hourglass_work), json_number(t.hourglass_energy),
                                 json_number(t.boundary_work), json_number(t.energy_given),
                                 json_number(t.energy_error)));
     std::string planes = "[";

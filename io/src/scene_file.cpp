@@ -32,14 +32,14 @@ const std::vector<std::string_view> scene_keys{
 const std::vector<std::string_view> body_keys{
     "name",    "shape",     "material", "origin",         "size",         "radius",            "diameter",
     "length",  "spacing",   "spacing_z", "velocity",      "initial_stress", "connectivity",    "lattice_neighbours",
-    "discretisation",
+    "discretisation", "inner_radius",
 };
 const std::vector<std::string_view> plane_keys{"name", "kind", "axis", "position", "side", "lift_off"};
 const std::vector<std::string_view> prescribed_keys{"name", "body", "region", "velocity", "ramp"};
 const std::vector<std::string_view> region_keys{"box", "above", "below", "beyond_radius", "within_radius"};
 const std::vector<std::string_view> solver_keys{
     "connectivity", "switch_plastic_strain", "influence_distance", "weight",          "viscosity",
-    "normalisation", "viscosity_linear", "viscosity_quadratic", "bond_viscosity_eps0", "hourglass_coefficient", "smoothing",     "smoothing_coefficient",
+    "normalisation", "viscosity_linear", "viscosity_quadratic", "bond_viscosity_eps0", "hourglass_coefficient", "hourglass_stiffness", "smoothing",     "smoothing_coefficient",
     "cfl",          "alpha_limit",           "max_time_step",      "time_step_growth", "max_volume_change", "failure",
     "separate_failed", "sliding_contact", "energy_update", "node_diameter",
     "scatter",      "reorder_interval",      "neighbour_skin",
@@ -239,6 +239,17 @@ BodySpec read_body(const Reporter& reporter, const toml::table& table, std::size
         b.length = *length;
     } else if (b.shape == ShapeKind::Sphere && r.has("length")) {
         r.fail_at("length", "does not apply to a sphere (give radius or diameter)");
+    }
+    if (r.has("inner_radius")) {
+        if (b.shape != ShapeKind::Sphere) {
+            r.fail_at("inner_radius", fmt::format("applies to a sphere only (a hollow sphere; a ring in plane strain), not a {}",
+                                                  shape_name));
+        }
+        b.inner_radius = *r.quantity("inner_radius", D::Length, Limit::NonNegative);
+        if (!(b.inner_radius < b.radius)) {
+            r.fail_at("inner_radius", fmt::format("{} m must be less than the radius, {} m: nothing would be left of the {}",
+                                                  b.inner_radius, b.radius, geometry == GeometryKind::PlaneStrain ? "ring" : "shell"));
+        }
     }
 
     b.spacing = r.required_quantity("spacing", D::Length, Limit::Positive);
@@ -451,6 +462,7 @@ SolverOptions read_solver(const Reporter& reporter, const toml::table& table) {
     if (const auto v = r.quantity("viscosity_quadratic", D::Dimensionless)) s.viscosity_quadratic = *v;
     if (const auto v = r.quantity("bond_viscosity_eps0", D::Dimensionless)) s.bond_viscosity_eps0 = *v;
     if (const auto v = r.quantity("hourglass_coefficient", D::Dimensionless)) s.hourglass_coefficient = *v;
+    if (const auto v = r.quantity("hourglass_stiffness", D::Dimensionless)) s.hourglass_stiffness = *v;
     if (const auto v = r.choice<SmoothingMode>("smoothing", {{"off", SmoothingMode::Off},
                                                              {"everywhere", SmoothingMode::Everywhere},
                                                              {"tension", SmoothingMode::Tension}})) {

@@ -94,7 +94,7 @@ const std::vector<ChoiceKey> choice_keys{
 
 const std::vector<const char*> number_keys{
     "cfl", "influence_distance", "switch_plastic_strain", "viscosity_linear", "viscosity_quadratic",
-    "bond_viscosity_eps0", "hourglass_coefficient", "smoothing_coefficient", "alpha_limit",
+    "bond_viscosity_eps0", "hourglass_coefficient", "hourglass_stiffness", "smoothing_coefficient", "alpha_limit",
 };
 
 const ChoiceKey* find_choice_key(std::string_view key) {
@@ -419,6 +419,7 @@ void apply_variant(const Variant& variant, Scene& scene) {
             else if (key == "viscosity_quadratic") o.viscosity_quadratic = x;
             else if (key == "bond_viscosity_eps0") o.bond_viscosity_eps0 = x;
             else if (key == "hourglass_coefficient") o.hourglass_coefficient = x;
+            else if (key == "hourglass_stiffness") o.hourglass_stiffness = x;
             else if (key == "smoothing_coefficient") o.smoothing_coefficient = x;
             else if (key == "alpha_limit") o.alpha_limit = x;
             else throw InputError(fmt::format("--variant {}: unknown key '{}'", variant.name, key));

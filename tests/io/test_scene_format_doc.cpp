@@ -98,6 +98,7 @@ TEST(SceneFormatDoc, DefaultsAreThoseOfSceneHpp) {
     expect_number(doc, "bond_viscosity_eps0", s.bond_viscosity_eps0);
     expect_word(doc, "smoothing", word(s.smoothing));
     expect_number(doc, "hourglass_coefficient", s.hourglass_coefficient);
+    expect_number(doc, "hourglass_stiffness", s.hourglass_stiffness);
     expect_number(doc, "smoothing_coefficient", s.smoothing_coefficient);
     expect_number(doc, "cfl", s.cfl);
     expect_number(doc, "alpha_limit", s.alpha_limit);
@@ -130,7 +131,7 @@ TEST(SceneFormatDoc, DefaultsAreThoseOfSceneHpp) {
 
     // 24 solver options, 4 stop criteria, 5 output options, and no row for an option that does
     // not exist.
-    EXPECT_EQ(doc.size(), 34u) << "rows in [solver], [stop] and [output] of docs/scene-format.md";
+    EXPECT_EQ(doc.size(), 35u) << "rows in [solver], [stop] and [output] of docs/scene-format.md";
 }
 
 }  // namespace

@@ -32,9 +32,16 @@ struct HourglassFields {
     // Variable-connectivity centres are controlled while their equivalent plastic strain is below
     // this (the lattice regime, where the mode lives: see apply_hourglass_control); fixed ones always.
     double lattice_plastic_strain = 0.0;
+    // The stiffness form (kernels.hpp, hourglass_stiffness): C_hs > 0 adds, on fixed centres, forces
+    // against the non-affine part of the lattice pairs' displacement since t = 0 (pairs of two fixed
+    // nodes of one body), from the initial positions and diameters.
+    double stiffness = 0.0;  // C_hs; 0 = none
+    std::array<const double*, D> initial_position{};
+    const double* initial_diameter = nullptr;
     // outputs
     std::array<double*, D> force{};  // added to; all null: only the power is computed
-    double* power = nullptr;         // per centre: the power of its control forces (<= 0), W
+    double* power = nullptr;         // per centre: the power of its damping forces (<= 0), W
+    double* stiffness_power = nullptr;  // per centre: the power of its stiffness forces (either sign), W; set with stiffness
     // Optional: the power is that of the forces (made from `velocity`) at these velocities instead,
     // sum_j F_j . (w_j - w_i); the compatible energy update books the heat at the mean velocities of
     // the velocity update (docs/energy.md).
@@ -44,13 +51,19 @@ struct HourglassFields {
 template <int D>
 HourglassFields<D> hourglass_fields(NodeStore& nodes, double lattice_plastic_strain, double* power);
 
+// The same with the stiffness form on (C_hs = stiffness > 0), its power per centre into stiffness_power.
+template <int D>
+HourglassFields<D> hourglass_fields(NodeStore& nodes, double lattice_plastic_strain, double* power, double stiffness,
+                                    double* stiffness_power);
+
 // Adds the control forces of the controlled centres in [0, real_count) over their pairs with real
 // neighbours of their own body (ghosts and other bodies take no part) to f.force, by the colours
 // of `plan` (a conflict-free plan of `lists`), and writes each centre's power (0 for the others).
 // Controlled centres: every fixed-connectivity node, whose lattice stencil has the exact
 // zero-energy mode, and every variable-connectivity node still in the lattice regime (plastic
 // strain below f.lattice_plastic_strain), whose neighbourhood is still the regular lattice and
-// carries the same mode nearly undamped (docs/connectivity.md). coefficient: C_hg > 0.
+// carries the same mode nearly undamped (docs/connectivity.md). coefficient: C_hg >= 0 (0: the
+// stiffness form alone, when f.stiffness > 0).
 template <int D>
 void apply_hourglass_control(const CompressedRows& lists, const ScatterPlan& plan, const HourglassFields<D>& f,
                              std::size_t real_count, double coefficient);

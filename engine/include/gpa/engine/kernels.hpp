@@ -185,6 +185,32 @@ inline Vec<D> hourglass_velocity_error(const Mat<D>& fitted_gradient, const Vec<
     return dv - fitted_gradient * r;
 }
 
+// Hourglass stiffness of fixed-connectivity centres (spec section 2, "[spec] Hourglass control",
+// its stiffness form; docs/tension.md). The damping above only slows the lattice's odd-even mode;
+// under tension the pair forces of Eq. 21-22, which scale with 1 / r_ij, pull the nearer of two
+// neighbours harder than the farther, a negative stiffness of order sigma / r^2 per unit mass that
+// makes the mode grow while the strain rates (Eq. 7-8) still do not see it. The stiffness resists
+// the part of the lattice pairs' *displacement* that no affine map of the initial lattice explains:
+//   e_ij = (x_j - x_i) - Ffit_i (X_j - X_i),   Ffit_i = [sum_j w_j dx_j dX_j^T] [sum_j w_j dX_j dX_j^T]^-1,
+// w_j = 1 / |X_j - X_i|^2 from the initial positions X, with the pair forces
+//   F_j = - k_i w_j e_ij / sum_k w_k,   F_i = - sum_j F_j,   k_i = C_hs M_i c_i^2 / d0_i^2.
+// They are the gradient of U_i = k_i sum_j w_j |e_ij|^2 / (2 sum_k w_k) (Ffit minimises it, so its
+// own change contributes nothing), equal and opposite, and zero for every affine map of the lattice:
+// rigid motion, rotation and uniform stretch of any size feel nothing. k_i / M_i = C_hs (c_i / d0_i)^2,
+// against the mode's negative stiffness of about 4 sigma / (rho d0^2): C_hs = 0.05 holds it up to a
+// tensile stress of about 1 % of rho c^2 (3 GPa in steel). The fit reuses accumulate_hourglass_fit
+// with r = dX, dv = dx.
+inline double hourglass_stiffness(double coefficient, double mass, double sound_speed, double initial_diameter) {
+    return coefficient * mass * sound_speed * sound_speed / (initial_diameter * initial_diameter);
+}
+
+// e_ij = dx_j - Ffit_i dX_j: the part of a lattice pair's displacement that no affine map of the
+// initial lattice around the centre explains.
+template <int D>
+inline Vec<D> hourglass_displacement_error(const Mat<D>& fitted_map, const Vec<D>& initial_offset, const Vec<D>& offset) {
+    return offset - fitted_map * initial_offset;
+}
+
 // The volume ratio of a lattice cell of a fixed-connectivity node (spec section 2, "[spec] Lattice
 // cells"): the cell spanned by the edges from the node to D of its axis neighbours (one per axis),
 // its signed area (2D) or volume (3D) now over that on the initial lattice. In axisymmetric

@@ -70,6 +70,9 @@ struct BodySpec {
     std::array<double, 3> origin{0, 0, 0};
     std::array<double, 3> size{0, 0, 0};  // rectangle/box
     double radius = 0.0;                  // cylinder/plate/sphere
+    // Sphere only: the radius of a hollow core, 0 = solid. A hollow sphere in 3D and in axisymmetric
+    // geometry, an annulus (a ring) in plane strain.
+    double inner_radius = 0.0;
     double length = 0.0;                  // cylinder/plate, along z
     double spacing = 0.0;                 // lattice spacing dx (and dy, dz in 3D)
     double spacing_z = 0.0;               // 2D: dz; 0 = equal to dx
@@ -155,6 +158,10 @@ struct SolverOptions {
     // C_hg of the zero-energy-mode control of fixed-connectivity centres (kernels.hpp, spec
     // section 2): 0 = off. It acts only on fixed nodes (fixed and automatic bodies).
     double hourglass_coefficient = 0.1;
+    // C_hs of the stiffness form of the control (kernels.hpp, hourglass_stiffness): on fixed nodes,
+    // forces against the non-affine part of the lattice pairs' displacement since t = 0, which the
+    // damping alone cannot hold under tension (docs/tension.md). 0 = off.
+    double hourglass_stiffness = 0.0;
     SmoothingMode smoothing = SmoothingMode::Off;
     double smoothing_coefficient = 0.1;  // C_cs (Eq. 67)
     // C_cfl of the stable time step (spec section 11). The largest value found stable: 0.6 (the

@@ -83,6 +83,7 @@ struct Totals {
     double plastic_work = 0.0;     // sum M w_p, J
     double viscous_work = 0.0;     // work of artificial viscosity (nodal, bond and hourglass control), J
     double hourglass_work = 0.0;   // the part of viscous_work done by the hourglass control of fixed nodes, J
+    double hourglass_energy = 0.0; // the part of internal_energy put in by the hourglass stiffness (solver.hourglass_stiffness), J
     double boundary_work = 0.0;    // energy removed by velocity constraints (less the work of prescribed velocities), J
     double initial_kinetic_energy = 0.0;  // J
     double initial_energy = 0.0;   // kinetic + internal at t = 0, J
@@ -207,7 +208,7 @@ public:
     // Reads the header of a checkpoint (no Simulation needed). Throws CheckpointError.
     static CheckpointInfo checkpoint_info(std::istream& in, std::uint64_t size, const std::string& source);
     // The format version save_checkpoint writes.
-    static constexpr std::uint32_t checkpoint_format = 2;
+    static constexpr std::uint32_t checkpoint_format = 3;  // 3: with the hourglass stiffness energy
 
 private:
     struct Impl;
