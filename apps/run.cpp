@@ -503,7 +503,8 @@ private:
 
 int fresh_run(const RunOptions& options) {
     SceneSource source = read_source(options.scene);
-    const Scene scene = io::parse_scene(source.text, source.name);
+    Scene scene = io::parse_scene(source.text, source.name);
+    if (options.scene) io::resolve_scene_files(scene, *options.scene);
     const fs::path output = options.output.value_or(default_output_folder("runs", scene.name));
     Simulation sim(scene, options.threads, options.memory);  // before the folder: an impossible scene leaves nothing behind
     io::RunFolder folder(output, options.overwrite);
@@ -547,7 +548,17 @@ int resumed_run(const RunOptions& options) {
         throw CheckpointError(fmt::format("'{}' is not the scene the run in '{}' started with (its copy is '{}')", source.name,
                                           folder.partial().string(), copy.string()));
     }
-    const Scene scene = io::parse_scene(source.text, source.name);
+    Scene scene = io::parse_scene(source.text, source.name);
+    // The files the scene names are relative to the scene file the run started from (the copy in
+    // the folder has no such neighbours); one that is no longer there is reported at the end.
+    const fs::path original = options.scene ? *options.scene : fs::path(decode(info.user_data, checkpoint.string()).scene_file);
+    if (!scene.element_reference.empty() && fs::exists(original)) {
+        try {
+            io::resolve_scene_files(scene, original);
+        } catch (const InputError& e) {
+            spdlog::warn("{}", e.what());
+        }
+    }
     Simulation sim(scene, options.threads, options.memory);
     const std::string user = io::read_checkpoint(checkpoint, sim, io::scene_fingerprint(source.text));
     RunState state = decode(user, checkpoint.string());

@@ -654,18 +654,21 @@ std::string read_scene_text(const std::filesystem::path& file) {
     return text;
 }
 
+void resolve_scene_files(Scene& scene, const std::filesystem::path& scene_file) {
+    if (scene.element_reference.empty()) return;
+    if (std::filesystem::path(scene.element_reference).is_relative()) {
+        scene.element_reference = (scene_file.parent_path() / scene.element_reference).lexically_normal().string();
+    }
+    try {
+        read_element_reference(scene.element_reference);
+    } catch (const InputError& e) {
+        throw InputError(fmt::format("{}: reference.elements: {}", scene_file.string(), e.what()));
+    }
+}
+
 Scene load_scene(const std::filesystem::path& file) {
     Scene scene = parse_scene(read_scene_text(file), file.string());
-    if (!scene.element_reference.empty() && std::filesystem::path(scene.element_reference).is_relative()) {
-        scene.element_reference = (file.parent_path() / scene.element_reference).lexically_normal().string();
-    }
-    if (!scene.element_reference.empty()) {
-        try {
-            read_element_reference(scene.element_reference);
-        } catch (const InputError& e) {
-            throw InputError(fmt::format("{}: reference.elements: {}", file.string(), e.what()));
-        }
-    }
+    resolve_scene_files(scene, file);
     return scene;
 }
 

@@ -117,6 +117,16 @@ grep -q '"element_reference": {"file"' run-ref/summary.json || fail "summary.jso
 sed "s#^source = \"one-dimensional elastic wave theory\"#&\nelements = \"no-such-reference.toml\"#" "$bar" > bar-noref.toml
 expect 2 "scene naming a missing reference" -- "$gpa" check bar-noref.toml
 grep -q "reference.elements" err.txt || fail "the message does not name reference.elements: $(cat err.txt)"
+expect 2 "run of a scene naming a missing reference" -- "$gpa" run bar-noref.toml -o run-noref -q
+grep -q "reference.elements" err.txt || fail "run: the message does not name reference.elements: $(cat err.txt)"
+[[ -e run-noref || -e run-noref.partial ]] && fail "run of a scene naming a missing reference left an output folder"
+#    A relative reference is found beside the scene file, whatever the working folder (as the
+#    scenes in scenes/ name theirs), by run and study alike.
+mkdir -p sub/references && cp ref.toml sub/references/bar.elements.toml
+sed "s#^source = \"one-dimensional elastic wave theory\"#&\nelements = \"references/bar.elements.toml\"#" "$bar" > sub/bar-rel.toml
+expect 0 "run against a relative reference" -- "$gpa" run sub/bar-rel.toml -o run-rel -q
+grep -q '"element_reference": {"file"' run-rel/summary.json || fail "summary.json lacks the relative element reference"
+grep -q '"element_reference": {[^}]*"error"' run-rel/summary.json && fail "the relative element reference was not found: $(grep -o '"element_reference": {[^}]*}' run-rel/summary.json)"
 
 # Bad options: one line naming the option, exit 2, and no output folder.
 study_refused() {

@@ -10,7 +10,7 @@ rm -rf "$work"; mkdir -p "$work"; cd "$work" || exit 1
 failures=0
 fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
 for spacing in 0.381 0.254 0.1905; do
-  sed -e 's/^connectivity = "variable"/connectivity = "fixed"/' -e "s/^spacing = \"0.254 mm\"/spacing = \"$spacing mm\"/" \
+  sed -e "/^elements = /d" -e 's/^connectivity = "variable"/connectivity = "fixed"/' -e "s/^spacing = \"0.254 mm\"/spacing = \"$spacing mm\"/" \
     "$src/scenes/taylor-copper-190.toml" > "fixed-$spacing.toml"
   grep -q '^connectivity = "fixed"' "fixed-$spacing.toml" || fail "could not make the fixed scene"
   "$gpa" run "fixed-$spacing.toml" -o "run-$spacing" -q > out.txt 2> err.txt

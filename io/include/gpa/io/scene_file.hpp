@@ -21,9 +21,14 @@ public:
     using InputError::InputError;
 };
 
-// Reads and parses a scene file. Messages name the file as given. Throws SceneError (also when
-// the file cannot be read).
+// Reads and parses a scene file, then resolves the files it names (resolve_scene_files). Messages
+// name the file as given. Throws SceneError (also when the file cannot be read).
 Scene load_scene(const std::filesystem::path& file);
+
+// Makes the relative file names of a parsed scene (`[reference] elements`) relative to the folder
+// of `scene_file`, the file the text came from, and checks that they can be read: a scene is
+// refused at once, naming the key, rather than at the end of its run. Throws InputError.
+void resolve_scene_files(Scene& scene, const std::filesystem::path& scene_file);
 
 // The bytes of a scene file, read with the scene-size limit (16 MiB) whatever the file is: a
 // device or a pipe that never ends is refused once it passes the limit. Throws SceneError.
