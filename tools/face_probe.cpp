@@ -3,6 +3,7 @@
 // raw peak and where it is, the number of nodes whose alpha hit the limit. Elements: the triangles
 // touching the face.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -20,7 +21,7 @@ using namespace gpa;
 
 int main(int argc, char** argv) {
     if (argc < 2) {
-        std::fprintf(stderr, "face_probe SCENE [refine] [variant-spec]\n");
+        std::fprintf(stderr, "face_probe SCENE [refine] [variant-spec] [nodes.csv]\n");
         return 2;
     }
     Scene scene = io::load_scene(argv[1]);
@@ -28,7 +29,27 @@ int main(int argc, char** argv) {
     if (argc > 3) io::apply_variant(io::parse_variant(argv[3]), scene);
     scene = io::refined(scene, factor);
     Simulation sim(scene, 1);
+    // With a fourth argument: every node's initial and final position (and, for particles, its
+    // section and plastic strain) to that CSV file, to compare displacement fields.
+    std::array<std::vector<double>, 2> element_start;
+    if (const ElementPart* e = sim.elements()) element_start = e->mesh().nodes.position;
     while (!sim.finished()) sim.step();
+    if (argc > 4) {
+        std::FILE* out = std::fopen(argv[4], "w");
+        if (!out) { std::fprintf(stderr, "cannot write %s\n", argv[4]); return 1; }
+        std::fprintf(out, "x0,z0,x,z,section,plastic_strain\n");
+        if (const ElementPart* e = sim.elements()) {
+            const auto& p = e->mesh().nodes.position;
+            for (std::size_t i = 0; i < p[0].size(); ++i)
+                std::fprintf(out, "%.9e,%.9e,%.9e,%.9e,0,0\n", element_start[0][i], element_start[1][i], p[0][i], p[1][i]);
+        } else {
+            const auto& n = sim.nodes();
+            for (std::size_t i = 0; i < sim.real_count(); ++i)
+                std::fprintf(out, "%.9e,%.9e,%.9e,%.9e,%.9e,%.6f\n", n.initial_position[0][i], n.initial_position[1][i],
+                             n.position[0][i], n.position[1][i], n.size_weight[i], n.plastic_strain[i]);
+        }
+        std::fclose(out);
+    }
     sim.measure_bodies();
     const auto& t = sim.totals();
     fmt::print("local: peak strain {:.4f} at ({:.3f}, {:.3f}) mm, max {:.4f}; peak T {:.1f} K; face roughness {:.4f} over {} points\n",

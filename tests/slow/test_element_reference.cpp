@@ -77,7 +77,26 @@ void against_elements(const std::string& name) {
     EXPECT_LT(std::abs(dd), 0.03) << name << ": footprint " << r.footprint << " m";
 }
 
-TEST(AgainstElements, Copper190LengthAndFootprint) { against_elements("taylor-copper-190"); }
+// Copper 190 against its element reference, and the issue's copper acceptance in the same run (one
+// bar per ctest process): GPA no farther from the measured length and footprint (Johnson and Cook
+// 1983) than the element solution of the same model is, plus 1 %. The element reference's own
+// distance from the experiment (+7.3 % long, +7.6 % wide) is the model's error; the 1 % is what the
+// issue allows the particles to add. Met since the Taylor scenes take the SPH-NSF weight at a = 1.3
+// (docs/validation.md, "The weight at the impact face"); with the paper's weight at a = 1 GPA's
+// footprint was +10.0 %.
+TEST(AgainstElements, Copper190AgainstTheElementsAndNoFartherFromTheExperimentThanTheyArePlusOnePercent) {
+    against_elements("taylor-copper-190");
+    const Result r = run("taylor-copper-190");
+    for (const char* key : {"final_length", "footprint_diameter"}) {
+        const double measured = r.experiment.at(key);
+        const double gpa = std::string(key) == "final_length" ? r.length : r.footprint;
+        const double gpa_error = std::abs(gpa / measured - 1.0);
+        const double element_error = std::abs(reference(r, key) / measured - 1.0);
+        std::printf("[ measured ] copper 190 %s: GPA %+.2f %%, elements %+.2f %% from the experiment\n", key,
+                    100 * (gpa / measured - 1.0), 100 * (reference(r, key) / measured - 1.0));
+        EXPECT_LE(gpa_error, element_error + 0.01) << key;
+    }
+}
 TEST(AgainstElements, ArmcoCylinderLengthAndFootprint) { against_elements("armco-cylinder-nodal"); }
 
 // One test for steel 208, so that ctest (a process per test) runs its bar once.
@@ -99,26 +118,6 @@ TEST(AgainstElements, Steel208LengthFootprintPeakPlasticStrainAndAFaceWithoutSca
     EXPECT_LT(r.roughness, 0.025);
     const Result eq3 = run("taylor-steel-208", NodeDiameter::Section);
     EXPECT_LT(r.roughness, eq3.roughness) << "Eq. 3's diameters: " << eq3.roughness;
-}
-
-// The issue's copper acceptance. NOT MET, so disabled (run it with --gtest_also_run_disabled_tests):
-// the length passes (GPA +7.4 %, elements +7.3 % from the measured 16.21 mm), the footprint does
-// not (GPA 14.92 mm at 20 across, +10.0 % from the measured 13.56 mm, against the element
-// reference's 14.59 mm, +7.6 %; with Eq. 3's diameters 14.76 mm, +8.9 %). docs/validation.md,
-// "The copper question", has the figures; enable it when GPA's footprint on copper is within 1 %
-// of the element solution's.
-TEST(AgainstElements, DISABLED_Copper190NoFartherFromTheExperimentThanTheElementsPlusOnePercent) {
-    const Result r = run("taylor-copper-190");
-    for (const char* key : {"final_length", "footprint_diameter"}) {
-        const double measured = r.experiment.at(key);
-        const double gpa = std::string(key) == "final_length" ? r.length : r.footprint;
-        const double gpa_error = std::abs(gpa / measured - 1.0);
-        const double element_error = std::abs(reference(r, key) / measured - 1.0);
-        std::printf("[ measured ] copper 190 %s: GPA %+.2f %%, elements %+.2f %% from the experiment\n", key,
-                    100 * (gpa / measured - 1.0), 100 * (reference(r, key) / measured - 1.0));
-        // The issue's acceptance: the model's own error is the element reference's; GPA may add 1 %.
-        EXPECT_LE(gpa_error, element_error + 0.01) << key;
-    }
 }
 
 }  // namespace
