@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <set>
 
@@ -24,14 +25,16 @@ constexpr double spacing = 1e-3;
 constexpr int cells = 14;
 
 // A plane-strain lattice whose lower half is fixed and upper half variable, as an automatic body
-// is once the nodes near the impact face have switched.
-NodeStore half_switched(double jitter) {
+// is once the nodes near the impact face have switched. `reach`: the fixed nodes' stencil beyond
+// the 8 (LatticeBlock::stencil_reach, in spacings).
+NodeStore half_switched(double jitter, double reach = 0.0) {
     testing::LatticeOptions o;
     o.geometry = GeometryKind::PlaneStrain;
     o.cells = cells;
     o.spacing = spacing;
     o.connectivity = Connectivity::Fixed;
     o.density = 7800.0;
+    o.stencil_reach = reach;
     NodeStore nodes = testing::make_lattice(o);
     for (std::size_t i = 0; i < nodes.size(); ++i) {
         if (nodes.position[1][i] > 0.5 * cells * spacing) nodes.connectivity[i] = Connectivity::Variable;
@@ -43,10 +46,14 @@ NodeStore half_switched(double jitter) {
 // Under a uniform stress every node with a complete neighbourhood must feel no net force. Before
 // lattice pairs weighed R(r/h) (they had R = 1 against R(v) of variable pairs) and before mixed
 // pairs were symmetric, the nodes next to the front took a spurious force of a quarter of the
-// stress times their area: the front tore, and switched bars came out short.
-TEST(MixedConnectivity, AUniformStressGivesNoForceAcrossTheFront) {
-    NodeStore nodes = half_switched(0.0);
-    const double a = 1.0;
+// stress times their area: the front tore, and switched bars came out short. The same holds at
+// a = 1.3 with the SPH-NSF weight (the Taylor scenes' setting) once the fixed nodes keep every
+// lattice node within 2 a d0 (bodies.cpp); with the 8 alone the front took a force of
+// `front_force_with_eight` below.
+// `margin`: the nodes checked are at least this many spacings from the edge of the lattice, so
+// that they and every neighbour of theirs have complete neighbourhoods (two rows of supports).
+void expect_no_force_across_the_front(WeightKind weight, double a, double reach, double margin, double* largest = nullptr) {
+    NodeStore nodes = half_switched(0.0, reach);
     const auto lists = find_neighbours(nodes, a, nodes.size());
     for (std::size_t i = 0; i < nodes.size(); ++i) {
         nodes.deviatoric_stress[0][i] = -4e7;
@@ -55,24 +62,43 @@ TEST(MixedConnectivity, AUniformStressGivesNoForceAcrossTheFront) {
         nodes.deviatoric_stress[3][i] = -2e7;
         nodes.pressure[i] = 5e8;
     }
-    compute_velocity_gradient<PlaneStrain>(lists, WeightKind::Gpa, gradient_fields<2>(nodes, a));
+    compute_velocity_gradient<PlaneStrain>(lists, weight, gradient_fields<2>(nodes, a));
     const PositionView x{2, {nodes.position[0].data(), nodes.position[1].data(), nullptr}};
     auto f = force_fields<2>(nodes, a);
     f.viscous_pressure = nullptr;
-    compute_forces<PlaneStrain>(lists, make_slab_plan(lists, x), WeightKind::Gpa, nullptr, f, nodes.size());
+    compute_forces<PlaneStrain>(lists, make_slab_plan(lists, x), weight, nullptr, f, nodes.size());
     testing::LatticeOptions o;
     o.cells = cells;
     o.spacing = spacing;
     const double scale = 5e8 * spacing;  // pressure times the face of a node (unit thickness)
     std::size_t checked = 0, at_front = 0;
+    double worst = 0.0;
     for (std::size_t i = 0; i < nodes.size(); ++i) {
-        if (testing::distance_to_boundary(nodes, o, i) < 2.1 * spacing) continue;
+        if (testing::distance_to_boundary(nodes, o, i) < margin * spacing) continue;
         ++checked;
         at_front += std::abs(nodes.position[1][i] - 0.5 * cells * spacing) < 1.6 * spacing;
-        for (int c = 0; c < 2; ++c) EXPECT_NEAR(nodes.force[c][i], 0.0, 1e-12 * scale) << "node " << i << " component " << c;
+        for (int c = 0; c < 2; ++c) worst = std::max(worst, std::abs(nodes.force[c][i]));
+        if (!largest) {
+            for (int c = 0; c < 2; ++c) EXPECT_NEAR(nodes.force[c][i], 0.0, 1e-12 * scale) << "node " << i << " component " << c;
+        }
     }
-    EXPECT_GT(checked, 50u);
-    EXPECT_GE(at_front, 16u);  // the rows on both sides of the front are among them
+    if (largest) *largest = worst / scale;
+    EXPECT_GE(checked, 36u);
+    EXPECT_GE(at_front, 12u);  // the rows on both sides of the front are among them
+}
+
+// a = 1: the support holds one row each side, so two rows from the edge.
+TEST(MixedConnectivity, AUniformStressGivesNoForceAcrossTheFront) { expect_no_force_across_the_front(WeightKind::Gpa, 1.0, 0.0, 2.1); }
+
+TEST(MixedConnectivity, AUniformStressGivesNoForceAcrossTheFrontWithTheSphNsfWeightAtAOfOnePointThree) {
+    // Reproduces the defect first: with the 8 lattice neighbours alone the fixed side of the front
+    // sees a different stencil from the variable side (20 neighbours within 2.6 spacings).
+    double with_eight = 0.0;
+    // a = 1.3: the support (2.6 spacings) holds two rows each side, so four rows from the edge.
+    expect_no_force_across_the_front(WeightKind::SphNsf, 1.3, 0.0, 4.1, &with_eight);
+    std::printf("[ measured ] largest front force with the 8 lattice neighbours: %.3g of P d\n", with_eight);
+    EXPECT_GT(with_eight, 1e-3);
+    expect_no_force_across_the_front(WeightKind::SphNsf, 1.3, 2.6, 4.1);
 }
 
 // A pair is in both rows or in neither (within one body): lattice pairs link two fixed nodes,

@@ -1,5 +1,6 @@
 #include "gpa/engine/lattice.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <optional>
@@ -24,18 +25,25 @@ int check_lattice_stencil(int dim, int neighbours) {
 
 namespace {
 
-// Lattice offsets of a stencil: those with 1 (4/6), up to 2 (8/18) or up to 3 (26) non-zero
-// components, in a fixed order.
-std::vector<std::array<int, 3>> stencil_offsets(int dim, int neighbours) {
+// Lattice offsets of a stencil: within the 3^D box those with 1 (4/6), up to 2 (8/18) or up to 3
+// (26) non-zero components, and beyond it those closer than `reach` (m, on the undeformed lattice
+// of spacing `spacing`); in a fixed order (by z, y, x offset). 2D offsets are (dx, dz) in
+// components 0 and 1.
+std::vector<std::array<int, 3>> stencil_offsets(int dim, int neighbours, double reach, const std::array<double, 3>& spacing) {
     const int max_nonzero = (neighbours == 4 || neighbours == 6) ? 1 : (neighbours == 18 ? 2 : 3);
+    std::array<int, 3> box{1, 1, 1};
+    for (int c = 0; c < dim; ++c) box[c] = std::max(1, static_cast<int>(std::ceil(reach / spacing[c])));
+    const int zr = dim == 3 ? box[2] : 0;
     std::vector<std::array<int, 3>> out;
-    const int zr = dim == 3 ? 1 : 0;
     for (int dz = -zr; dz <= zr; ++dz) {
-        for (int dy = -1; dy <= 1; ++dy) {
-            for (int dx = -1; dx <= 1; ++dx) {
+        for (int dy = -box[1]; dy <= box[1]; ++dy) {
+            for (int dx = -box[0]; dx <= box[0]; ++dx) {
                 const int nonzero = (dx != 0) + (dy != 0) + (dz != 0);
-                if (nonzero == 0 || nonzero > max_nonzero) continue;
-                out.push_back({dx, dy, dz});
+                if (nonzero == 0) continue;
+                const bool in_box = std::abs(dx) <= 1 && std::abs(dy) <= 1 && std::abs(dz) <= 1;
+                const double ex = dx * spacing[0], ey = dy * spacing[1], ez = dim == 3 ? dz * spacing[2] : 0.0;
+                const bool within_reach = ex * ex + ey * ey + ez * ez < reach * reach;
+                if ((in_box && nonzero <= max_nonzero) || within_reach) out.push_back({dx, dy, dz});
             }
         }
     }
@@ -130,7 +138,7 @@ std::size_t fill_lattice(NodeStore& nodes, const LatticeBlock& block) {
     // Fixed lists of the new nodes: their stencil neighbours that exist, in stencil order; and
     // where a stencil neighbour falls behind mirror planes, the ghost image of the cell that
     // mirrors it (the lattice continues across the plane, spec section 7).
-    const auto offsets = stencil_offsets(dim, block.lattice_neighbours);
+    const auto offsets = stencil_offsets(dim, block.lattice_neighbours, block.stencil_reach, block.spacing);
     auto& rows = nodes.fixed_neighbours;
     rows.offsets.resize(first_new + 1);
     rows.indices.resize(rows.offsets.back());

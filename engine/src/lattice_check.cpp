@@ -35,7 +35,12 @@ void ratios(const NodeStore& n, std::size_t real_count, bool axisymmetric, std::
                     }
                 }
                 if (nonzero != 1) continue;
-                axis[along][n.initial_position[along][j] > n.initial_position[along][i] ? 1 : 0] = j;
+                // The nearest along the axis on each side (a stencil reaching beyond the box, a > 1,
+                // also holds the nodes two spacings away).
+                const double offset = n.initial_position[along][j] - n.initial_position[along][i];
+                std::int64_t& slot = axis[along][offset > 0.0 ? 1 : 0];
+                if (slot >= 0 && std::abs(n.initial_position[along][static_cast<std::size_t>(slot)] - n.initial_position[along][i]) <= std::abs(offset)) continue;
+                slot = j;
             }
             double smallest = none;
             // Every choice of one side per axis is a cell (2^D of them).

@@ -27,13 +27,6 @@ Shape run(const std::string& scene_name, double spacing, ConnectivityMode mode) 
         b.connectivity.reset();
     }
     s.solver.connectivity = mode;
-    // The paper's weight and influence distance (Eq. 1b, a = 1), with which switching was made to
-    // agree with all-variable. The Taylor scenes now take the SPH-NSF weight at a = 1.3 (issue 13,
-    // docs/validation.md); with it automatic switching drifts from all-variable with refinement
-    // (steel 208 footprint -0.43, -0.44, -0.81, -1.72 % at 10, 15, 20, 25 across:
-    // docs/connectivity.md), which is open work, not what this test measures.
-    s.solver.weight = WeightKind::Gpa;
-    s.solver.influence_distance = 1.0;
     Simulation sim(s, 1);
     while (!sim.finished()) sim.step();
     const auto& t = sim.totals();
