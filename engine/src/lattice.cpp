@@ -82,6 +82,10 @@ std::size_t fill_lattice(NodeStore& nodes, const LatticeBlock& block) {
     const double cell_area = block.spacing[0] * block.spacing[1];
     const double cell_volume = dim == 3 ? cell_area * block.spacing[2] : cell_area;
     const double d0 = dim == 3 ? block.spacing[0] : std::sqrt(cell_area);
+    // The stencil's reach is 2 a d0 with a at most 1.5 (spec section 2): 3 d0 and no more.
+    if (!(block.stencil_reach >= 0.0) || block.stencil_reach > 3.0 * d0 * (1.0 + 1e-12)) {
+        throw InputError(fmt::format("lattice stencil reach {} m is not within [0, 3 d0] (d0 = {} m)", block.stencil_reach, d0));
+    }
 
     const std::size_t first_new = nodes.size();
     std::vector<std::array<std::int64_t, 3>> cells;
