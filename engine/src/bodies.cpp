@@ -153,10 +153,7 @@ std::size_t add_body_nodes(NodeStore& nodes, const Scene& scene, std::size_t ind
     // The default stencil is the neighbourhood of the undeformed lattice: the box of 8 (26) at
     // a <= 1, and every lattice node within 2 a spacings beyond it (spec section 2: r < 2 h, h =
     // a d0), so that fixed and variable nodes see the same neighbours until the lattice deforms.
-    if (b.lattice_neighbours == 0 && scene.solver.influence_distance > 1.0) {
-        const double d0 = dim == 3 ? block.spacing[0] : std::sqrt(block.spacing[0] * block.spacing[1]);
-        block.stencil_reach = 2.0 * scene.solver.influence_distance * d0;
-    }
+    if (b.lattice_neighbours == 0 && scene.solver.influence_distance > 1.0) block.stencil_reach = 2.0 * scene.solver.influence_distance;
     block.mirror_planes = mirrors;
     const std::size_t first = fill_lattice(nodes, block);
     if (nodes.size() == first) {

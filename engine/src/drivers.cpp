@@ -188,8 +188,7 @@ void forces_impl(const CompressedRows& lists, const ScatterPlan& plan, const Bon
         for (NodeIndex j : lists.row(i)) {
             const auto p = f.pairs.template pair<W>(i, j);
             const bool sliding = f.pairs.sliding(i, j);  // spec section 2: one direction only
-            Vec<D> n = p.l;  // the contact normal of a sliding pair (read only then)
-            if (sliding) n = f.pairs.sliding_normal(i, j, p.l);
+            [[maybe_unused]] const Vec<D> n = sliding ? f.pairs.sliding_normal(i, j, p.l) : p.l;  // contact normal, read only when sliding
             double q = 0.0;
             [[maybe_unused]] Vec<D> dv;
             if constexpr (with_bond_viscosity) {

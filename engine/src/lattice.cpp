@@ -83,8 +83,8 @@ std::size_t fill_lattice(NodeStore& nodes, const LatticeBlock& block) {
     const double cell_volume = dim == 3 ? cell_area * block.spacing[2] : cell_area;
     const double d0 = dim == 3 ? block.spacing[0] : std::sqrt(cell_area);
     // The stencil's reach is 2 a d0 with a at most 1.5 (spec section 2): 3 d0 and no more.
-    if (!(block.stencil_reach >= 0.0) || block.stencil_reach > 3.0 * d0 * (1.0 + 1e-12)) {
-        throw InputError(fmt::format("lattice stencil reach {} m is not within [0, 3 d0] (d0 = {} m)", block.stencil_reach, d0));
+    if (!(block.stencil_reach >= 0.0) || block.stencil_reach > 3.0 * (1.0 + 1e-12)) {
+        throw InputError(fmt::format("lattice stencil reach {} d0 is not within [0, 3]", block.stencil_reach));
     }
 
     const std::size_t first_new = nodes.size();
@@ -142,7 +142,7 @@ std::size_t fill_lattice(NodeStore& nodes, const LatticeBlock& block) {
     // Fixed lists of the new nodes: their stencil neighbours that exist, in stencil order; and
     // where a stencil neighbour falls behind mirror planes, the ghost image of the cell that
     // mirrors it (the lattice continues across the plane, spec section 7).
-    const auto offsets = stencil_offsets(dim, block.lattice_neighbours, block.stencil_reach, block.spacing);
+    const auto offsets = stencil_offsets(dim, block.lattice_neighbours, block.stencil_reach * d0, block.spacing);
     auto& rows = nodes.fixed_neighbours;
     rows.offsets.resize(first_new + 1);
     rows.indices.resize(rows.offsets.back());

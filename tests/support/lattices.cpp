@@ -15,7 +15,7 @@ NodeStore make_lattice(const LatticeOptions& o) {
     b.density = o.density;
     b.connectivity = o.connectivity;
     b.lattice_neighbours = o.lattice_neighbours ? o.lattice_neighbours : (dim == 3 ? 26 : 8);
-    b.stencil_reach = o.stencil_reach * o.spacing;
+    b.stencil_reach = o.stencil_reach;
     fill_lattice(nodes, b);
     return nodes;
 }

@@ -18,8 +18,8 @@ struct LatticeOptions {
     Connectivity connectivity = Connectivity::Variable;
     int lattice_neighbours = 0;  // 0: 8 in 2D, 26 in 3D
     double density = 1.0;
-    double stencil_reach = 0.0;  // LatticeBlock::stencil_reach, in spacings (a scene with a > 1: 2 a); last, so
-                                 // that the aggregate initialisers of the tests keep their meaning
+    double stencil_reach = 0.0;  // LatticeBlock::stencil_reach (d0 = spacing here); last, so that the
+                                 // aggregate initialisers of the tests keep their meaning
 };
 
 NodeStore make_lattice(const LatticeOptions& o);

@@ -38,10 +38,11 @@ struct LatticeBlock {
     std::int32_t material = 0;
     Connectivity connectivity = Connectivity::Variable;
     int lattice_neighbours = 8;                  // stencil of the fixed lists (see above)
-    // Beyond the stencil, every lattice node closer than this (m, on the undeformed lattice) is a
-    // lattice neighbour too; 0: the stencil alone. A body with influence distance a > 1 takes
-    // 2 a d0, so that its fixed nodes keep the neighbours a variable node finds on the undeformed
-    // lattice (r < 2 h, h = a d0) and a node that switches keeps its stencil (docs/connectivity.md).
+    // Beyond the stencil, every lattice node closer than this many d0 (on the undeformed lattice;
+    // d0 as below) is a lattice neighbour too; 0: the stencil alone; at most 3. A body with
+    // influence distance a > 1 takes 2 a, so that its fixed nodes keep the neighbours a variable
+    // node finds on the undeformed lattice (r < 2 h, h = a d0) and a node that switches keeps its
+    // stencil (docs/connectivity.md).
     double stencil_reach = 0.0;
     // Keeps the cells whose centre it accepts (x, z) or (x, y, z); empty: keep all.
     std::function<bool(const std::array<double, 3>&)> inside;
