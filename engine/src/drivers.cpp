@@ -242,7 +242,7 @@ void forces_impl(const CompressedRows& lists, const ScatterPlan& plan, const Bon
 template <class G, class W>
 void stress_power_impl(const CompressedRows& lists, const ForceFields<G::dim>& f,
                        const std::array<const double*, G::dim>& velocity, std::size_t n, double* power,
-                       double* viscous_power) {
+                       double* viscous_power, const HourglassFields<G::dim>* hourglass, double hourglass_coefficient) {
     constexpr int D = G::dim;
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024), [&](const tbb::blocked_range<std::size_t>& range) {
         for (std::size_t i = range.begin(); i != range.end(); ++i) {
@@ -269,6 +269,11 @@ void stress_power_impl(const CompressedRows& lists, const ForceFields<G::dim>& f
             }
             power[i] = sum;
             viscous_power[i] = q * volume * divergence;
+            if (hourglass) {
+                const HourglassPower h = hourglass_centre<D>(lists.row(i), i, *hourglass, n, hourglass_coefficient);
+                hourglass->power[i] = h.damping;
+                if (hourglass->stiffness_power) hourglass->stiffness_power[i] = h.stiffness;
+            }
         }
     });
 }
@@ -278,9 +283,10 @@ void stress_power_impl(const CompressedRows& lists, const ForceFields<G::dim>& f
 template <class G>
 void compute_stress_power(const CompressedRows& lists, WeightKind weight, const ForceFields<G::dim>& f,
                           const std::array<const double*, G::dim>& velocity, std::size_t real_count, double* power,
-                          double* viscous_power) {
+                          double* viscous_power, const HourglassFields<G::dim>* hourglass, double hourglass_coefficient) {
     dispatch_weight(weight, [&](auto w) {
-        stress_power_impl<G, decltype(w)>(lists, f, velocity, real_count, power, viscous_power);
+        stress_power_impl<G, decltype(w)>(lists, f, velocity, real_count, power, viscous_power, hourglass,
+                                          hourglass_coefficient);
     });
 }
 
@@ -322,11 +328,14 @@ void compute_forces(const CompressedRows& lists, const ScatterPlan& plan, Weight
 }
 
 template void compute_stress_power<PlaneStrain>(const CompressedRows&, WeightKind, const ForceFields<2>&,
-                                          const std::array<const double*, 2>&, std::size_t, double*, double*);
+                                          const std::array<const double*, 2>&, std::size_t, double*, double*,
+                                          const HourglassFields<2>*, double);
 template void compute_stress_power<Axisymmetric>(const CompressedRows&, WeightKind, const ForceFields<2>&,
-                                          const std::array<const double*, 2>&, std::size_t, double*, double*);
+                                          const std::array<const double*, 2>&, std::size_t, double*, double*,
+                                          const HourglassFields<2>*, double);
 template void compute_stress_power<ThreeD>(const CompressedRows&, WeightKind, const ForceFields<3>&,
-                                          const std::array<const double*, 3>&, std::size_t, double*, double*);
+                                          const std::array<const double*, 3>&, std::size_t, double*, double*,
+                                          const HourglassFields<3>*, double);
 template void compute_velocity_gradient<PlaneStrain>(const CompressedRows&, WeightKind,
                                                 const GradientFields<PlaneStrain::dim>&, std::size_t);
 template void compute_forces<PlaneStrain>(const CompressedRows&, const ScatterPlan&, WeightKind,

@@ -43,111 +43,113 @@ HourglassFields<D> hourglass_fields(NodeStore& nodes, double lattice_plastic_str
 }
 
 template <int D>
-void apply_hourglass_control(const CompressedRows& lists, const ScatterPlan& plan, const HourglassFields<D>& f,
-                             std::size_t real_count, double coefficient) {
-    const auto load = [](const std::array<const double*, D>& field, std::size_t i) {
+HourglassPower hourglass_centre(std::span<const NodeIndex> row, std::size_t i, const HourglassFields<D>& f,
+                                std::size_t real_count, double coefficient) {
+    const auto load = [](const std::array<const double*, D>& field, std::size_t k) {
         Vec<D> v;
-        for (int c = 0; c < D; ++c) v[c] = field[c][i];
+        for (int c = 0; c < D; ++c) v[c] = field[c][k];
         return v;
     };
+    HourglassPower out;
+    if (i >= real_count) return out;
+    if (f.connectivity[i] != Connectivity::Fixed && !(f.plastic_strain[i] < f.lattice_plastic_strain)) return out;
     // The pairs the control acts on: a centre's real neighbours of its own body (ghosts and other
     // bodies take no part, nor do the pairs of a failed node when those separate).
-    const auto controlled_pair = [&](std::size_t i, NodeIndex j) {
+    const auto controlled_pair = [&](NodeIndex j) {
         return j < real_count && f.body[j] == f.body[i] && !(f.failed && (f.failed[i] || f.failed[j]));
     };
     // The stiffness form acts on pairs of two fixed nodes: the lattice pairs, whose initial offsets
     // are the lattice's.
-    const bool with_stiffness = f.stiffness > 0.0;
-    const auto stiff_pair = [&](std::size_t i, NodeIndex j) {
-        return controlled_pair(i, j) && f.connectivity[j] == Connectivity::Fixed;
+    const auto stiff_pair = [&](NodeIndex j) { return controlled_pair(j) && f.connectivity[j] == Connectivity::Fixed; };
+    const Vec<D> x_i = load(f.position, i), v_i = load(f.velocity, i);
+    const bool other_velocity = f.power_velocity[0] != nullptr;
+    const bool scatter = f.force[0] != nullptr;
+    const Vec<D> w_i = other_velocity ? load(f.power_velocity, i) : Vec<D>::Zero().eval();
+    const auto power_of = [&](NodeIndex j, const Vec<D>& force_on_j, const Vec<D>& dv) {
+        return force_on_j.dot(other_velocity ? (load(f.power_velocity, j) - w_i).eval() : dv);
     };
-    const auto centre = [&](std::size_t i) {
-        f.power[i] = 0.0;
-        if (with_stiffness) f.stiffness_power[i] = 0.0;
-        if (i >= real_count) return;
-        if (f.connectivity[i] != Connectivity::Fixed && !(f.plastic_strain[i] < f.lattice_plastic_strain)) return;
-        const Vec<D> x_i = load(f.position, i), v_i = load(f.velocity, i);
-        const bool other_velocity = f.power_velocity[0] != nullptr;
-        const Vec<D> w_i = other_velocity ? load(f.power_velocity, i) : Vec<D>::Zero().eval();
-        const auto power_of = [&](NodeIndex j, const Vec<D>& force_on_j, const Vec<D>& dv) {
-            return force_on_j.dot(other_velocity ? (load(f.power_velocity, j) - w_i).eval() : dv);
-        };
-        Vec<D> on_centre = Vec<D>::Zero();
-        // A neighbourhood that gives no fit in some direction (a single row or column of nodes)
-        // has no affine reference to measure against: no control there.
-        const auto invert = [](const HourglassFit<D>& fit, Mat<D>& inverse) {
-            bool invertible = false;
-            double determinant = 0.0;
-            fit.moment.computeInverseAndDetWithCheck(inverse, determinant, invertible, 1e-12 * std::pow(fit.moment.trace(), D));
-            return invertible && fit.weight > 0.0;
-        };
-        if (coefficient > 0.0) {
-            // Pass 1: the weighted least-squares velocity gradient of the lattice pairs.
-            HourglassFit<D> fit;
-            for (NodeIndex j : lists.row(i)) {
-                if (!controlled_pair(i, j)) continue;
+    Vec<D> on_centre = Vec<D>::Zero();
+    // A neighbourhood that gives no fit in some direction (a single row or column of nodes)
+    // has no affine reference to measure against: no control there.
+    const auto invert = [](const HourglassFit<D>& fit, Mat<D>& inverse) {
+        bool invertible = false;
+        double determinant = 0.0;
+        fit.moment.computeInverseAndDetWithCheck(inverse, determinant, invertible, 1e-12 * std::pow(fit.moment.trace(), D));
+        return invertible && fit.weight > 0.0;
+    };
+    if (coefficient > 0.0) {
+        // Pass 1: the weighted least-squares velocity gradient of the lattice pairs.
+        HourglassFit<D> fit;
+        for (NodeIndex j : row) {
+            if (!controlled_pair(j)) continue;
+            const Vec<D> r = load(f.position, j) - x_i;
+            accumulate_hourglass_fit<D>(r, load(f.velocity, j) - v_i, hourglass_pair_weight(f.size_weight[j], r.squaredNorm()), fit);
+        }
+        Mat<D> inverse;
+        if (invert(fit, inverse)) {
+            const Mat<D> fitted_gradient = fit.difference * inverse;
+            const double kappa = hourglass_damping(coefficient, f.mass[i], f.sound_speed[i], f.smallest_h[i]) / fit.weight;
+            // Pass 2: F_j = - kappa w_j e_ij on the neighbour, the reaction on the centre.
+            for (NodeIndex j : row) {
+                if (!controlled_pair(j)) continue;
                 const Vec<D> r = load(f.position, j) - x_i;
-                accumulate_hourglass_fit<D>(r, load(f.velocity, j) - v_i, hourglass_pair_weight(f.size_weight[j], r.squaredNorm()), fit);
-            }
-            Mat<D> inverse;
-            if (invert(fit, inverse)) {
-                const Mat<D> fitted_gradient = fit.difference * inverse;
-                const double kappa = hourglass_damping(coefficient, f.mass[i], f.sound_speed[i], f.smallest_h[i]) / fit.weight;
-                // Pass 2: F_j = - kappa w_j e_ij on the neighbour, the reaction on the centre.
-                double power = 0.0;
-                for (NodeIndex j : lists.row(i)) {
-                    if (!controlled_pair(i, j)) continue;
-                    const Vec<D> r = load(f.position, j) - x_i;
-                    const Vec<D> dv = load(f.velocity, j) - v_i;
-                    const Vec<D> force_on_j = (-kappa * hourglass_pair_weight(f.size_weight[j], r.squaredNorm())) *
-                                              hourglass_velocity_error<D>(fitted_gradient, r, dv);
-                    if (f.force[0]) {
-                        for (int c = 0; c < D; ++c) f.force[c][j] += force_on_j[c];
-                    }
-                    on_centre -= force_on_j;
-                    power += power_of(j, force_on_j, dv);
+                const Vec<D> dv = load(f.velocity, j) - v_i;
+                const Vec<D> force_on_j = (-kappa * hourglass_pair_weight(f.size_weight[j], r.squaredNorm())) *
+                                          hourglass_velocity_error<D>(fitted_gradient, r, dv);
+                if (scatter) {
+                    for (int c = 0; c < D; ++c) f.force[c][j] += force_on_j[c];
                 }
-                f.power[i] = power;
+                on_centre -= force_on_j;
+                out.damping += power_of(j, force_on_j, dv);
             }
         }
-        if (with_stiffness && f.connectivity[i] == Connectivity::Fixed) {
-            // The stiffness form (kernels.hpp, hourglass_stiffness): the affine map of the initial
-            // lattice pairs that fits their current offsets best, then forces against the rest.
-            const Vec<D> x0_i = load(f.initial_position, i);
-            HourglassFit<D> fit;
-            for (NodeIndex j : lists.row(i)) {
-                if (!stiff_pair(i, j)) continue;
+    }
+    if (f.stiffness > 0.0 && f.connectivity[i] == Connectivity::Fixed) {
+        // The stiffness form (kernels.hpp, hourglass_stiffness): the affine map of the initial
+        // lattice pairs that fits their current offsets best, then forces against the rest.
+        const Vec<D> x0_i = load(f.initial_position, i);
+        HourglassFit<D> fit;
+        for (NodeIndex j : row) {
+            if (!stiff_pair(j)) continue;
+            const Vec<D> initial = load(f.initial_position, j) - x0_i;
+            accumulate_hourglass_fit<D>(initial, load(f.position, j) - x_i, hourglass_pair_weight(1.0, initial.squaredNorm()), fit);
+        }
+        Mat<D> inverse;
+        if (invert(fit, inverse)) {
+            const Mat<D> fitted_map = fit.difference * inverse;
+            const double k = hourglass_stiffness(f.stiffness, f.mass[i], f.sound_speed[i], f.initial_diameter[i]) / fit.weight;
+            for (NodeIndex j : row) {
+                if (!stiff_pair(j)) continue;
                 const Vec<D> initial = load(f.initial_position, j) - x0_i;
-                accumulate_hourglass_fit<D>(initial, load(f.position, j) - x_i, hourglass_pair_weight(1.0, initial.squaredNorm()), fit);
-            }
-            Mat<D> inverse;
-            if (invert(fit, inverse)) {
-                const Mat<D> fitted_map = fit.difference * inverse;
-                const double k = hourglass_stiffness(f.stiffness, f.mass[i], f.sound_speed[i], f.initial_diameter[i]) / fit.weight;
-                double power = 0.0;
-                for (NodeIndex j : lists.row(i)) {
-                    if (!stiff_pair(i, j)) continue;
-                    const Vec<D> initial = load(f.initial_position, j) - x0_i;
-                    const Vec<D> force_on_j = (-k * hourglass_pair_weight(1.0, initial.squaredNorm())) *
-                                              hourglass_displacement_error<D>(fitted_map, initial, load(f.position, j) - x_i);
-                    if (f.force[0]) {
-                        for (int c = 0; c < D; ++c) f.force[c][j] += force_on_j[c];
-                    }
-                    on_centre -= force_on_j;
-                    power += power_of(j, force_on_j, load(f.velocity, j) - v_i);
+                const Vec<D> force_on_j = (-k * hourglass_pair_weight(1.0, initial.squaredNorm())) *
+                                          hourglass_displacement_error<D>(fitted_map, initial, load(f.position, j) - x_i);
+                if (scatter) {
+                    for (int c = 0; c < D; ++c) f.force[c][j] += force_on_j[c];
                 }
-                f.stiffness_power[i] = power;
+                on_centre -= force_on_j;
+                out.stiffness += power_of(j, force_on_j, load(f.velocity, j) - v_i);
             }
         }
-        if (f.force[0]) {
-            for (int c = 0; c < D; ++c) f.force[c][i] += on_centre[c];
-        }
-    };
+    }
+    if (scatter) {
+        for (int c = 0; c < D; ++c) f.force[c][i] += on_centre[c];
+    }
+    return out;
+}
+
+template <int D>
+void apply_hourglass_control(const CompressedRows& lists, const ScatterPlan& plan, const HourglassFields<D>& f,
+                             std::size_t real_count, double coefficient) {
+    const bool with_stiffness = f.stiffness > 0.0;
     for (std::size_t colour = 0; colour < plan.colours(); ++colour) {
         tbb::parallel_for(tbb::blocked_range<std::size_t>(plan.colour_offsets[colour], plan.colour_offsets[colour + 1], 1),
                           [&](const tbb::blocked_range<std::size_t>& groups) {
                               for (std::size_t g = groups.begin(); g != groups.end(); ++g) {
-                                  for (NodeIndex i : plan.group(g)) centre(i);
+                                  for (NodeIndex i : plan.group(g)) {
+                                      const HourglassPower p = hourglass_centre<D>(lists.row(i), i, f, real_count, coefficient);
+                                      f.power[i] = p.damping;
+                                      if (with_stiffness) f.stiffness_power[i] = p.stiffness;
+                                  }
                               }
                           });
     }
@@ -159,5 +161,7 @@ template HourglassFields<2> hourglass_fields<2>(NodeStore&, double, double*, dou
 template HourglassFields<3> hourglass_fields<3>(NodeStore&, double, double*, double, double*);
 template void apply_hourglass_control<2>(const CompressedRows&, const ScatterPlan&, const HourglassFields<2>&, std::size_t, double);
 template void apply_hourglass_control<3>(const CompressedRows&, const ScatterPlan&, const HourglassFields<3>&, std::size_t, double);
+template HourglassPower hourglass_centre<2>(std::span<const NodeIndex>, std::size_t, const HourglassFields<2>&, std::size_t, double);
+template HourglassPower hourglass_centre<3>(std::span<const NodeIndex>, std::size_t, const HourglassFields<3>&, std::size_t, double);
 
 }  // namespace gpa

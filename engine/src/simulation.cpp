@@ -797,26 +797,27 @@ void Simulation::Impl::book_stress_work(double dt_avg) {
     f.pairs = with_contact(f.pairs);
     f.full_normalisation = scene.solver.normalisation == Normalisation::MomentMatrix;
     if (scene.solver.viscosity != ViscosityKind::Nodal) f.viscous_pressure = nullptr;  // as in forces()
-    compute_stress_power<G>(lists, scene.solver.weight, f, mean, real, stress_power.data(), viscous_power.data());
+    // The hourglass forces' power in the same pass (from the half-step velocities, as in forces(),
+    // their power taken at the mean velocities: the kinetic energy they remove in this update).
+    std::optional<HourglassFields<G::dim>> h;
+    if (with_hourglass) {
+        h = hourglass_fields<G::dim>(nodes, scene.solver.switch_plastic_strain, hourglass_power.data(),
+                                     scene.solver.hourglass_stiffness, hourglass_stiffness_power.data());
+        if (sliding_contact && separate_failed) h->failed = nodes.failed.data();
+        for (int c = 0; c < G::dim; ++c) {
+            h->velocity[c] = half_velocity[c].data();
+            h->force[c] = nullptr;
+            h->power_velocity[c] = mean[c];
+        }
+    }
+    compute_stress_power<G>(lists, scene.solver.weight, f, mean, real, stress_power.data(), viscous_power.data(),
+                            h ? &*h : nullptr, scene.solver.hourglass_coefficient);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, real, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
         for (std::size_t i = r.begin(); i != r.end(); ++i) {
             nodes.internal_energy[i] -= stress_power[i] * dt_avg / nodes.mass[i];
             nodes.viscous_work[i] -= viscous_power[i] * dt_avg / nodes.mass[i];
         }
     });
-    if (with_hourglass) {
-        // The hourglass forces again (from the half-step velocities, as in forces()), their power
-        // taken at the mean velocities: the kinetic energy they remove in this update.
-        auto h = hourglass_fields<G::dim>(nodes, scene.solver.switch_plastic_strain, hourglass_power.data(),
-                                          scene.solver.hourglass_stiffness, hourglass_stiffness_power.data());
-        if (sliding_contact && separate_failed) h.failed = nodes.failed.data();
-        for (int c = 0; c < G::dim; ++c) {
-            h.velocity[c] = half_velocity[c].data();
-            h.force[c] = nullptr;
-            h.power_velocity[c] = mean[c];
-        }
-        apply_hourglass_control<G::dim>(lists, plan, h, real, scene.solver.hourglass_coefficient);
-    }
 }
 
 template <class G>

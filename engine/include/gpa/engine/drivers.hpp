@@ -8,6 +8,7 @@
 #include "gpa/engine/colouring.hpp"
 #include "gpa/engine/compressed_rows.hpp"
 #include "gpa/engine/fields.hpp"
+#include "gpa/engine/hourglass.hpp"
 #include "gpa/engine/weights.hpp"
 
 namespace gpa {
@@ -47,9 +48,14 @@ void compute_forces(const CompressedRows& lists, const ScatterPlan& plan, Weight
 // sides of a velocity update, sum_i power_i dt is the kinetic energy the stress forces add in that
 // update, to round-off, so booking -power_i dt as internal energy of i conserves energy exactly.
 // `velocity` covers ghosts too (mirrored like the velocities themselves).
+// With `hourglass` set (its power_velocity the same velocities, no force), the same pass also
+// writes each centre's hourglass-control powers (hourglass.hpp, hourglass_centre) to
+// hourglass->power and hourglass->stiffness_power, while the centre's row is in cache: one visit
+// of every row for all the work the energy update books.
 template <class G>
 void compute_stress_power(const CompressedRows& lists, WeightKind weight, const ForceFields<G::dim>& f,
                           const std::array<const double*, G::dim>& velocity, std::size_t real_count, double* power,
-                          double* viscous_power);
+                          double* viscous_power, const HourglassFields<G::dim>* hourglass = nullptr,
+                          double hourglass_coefficient = 0.0);
 
 }  // namespace gpa

@@ -8,6 +8,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <span>
 
 #include "gpa/engine/colouring.hpp"
 #include "gpa/engine/compressed_rows.hpp"
@@ -64,6 +65,23 @@ HourglassFields<D> hourglass_fields(NodeStore& nodes, double lattice_plastic_str
 // strain below f.lattice_plastic_strain), whose neighbourhood is still the regular lattice and
 // carries the same mode nearly undamped (docs/connectivity.md). coefficient: C_hg >= 0 (0: the
 // stiffness form alone, when f.stiffness > 0).
+// The powers of one centre's control forces (W): the damping's (<= 0 at the velocities the forces
+// are made from) and the stiffness form's (either sign).
+struct HourglassPower {
+    double damping = 0.0;
+    double stiffness = 0.0;
+};
+
+// The control at one centre i with neighbour row `row` (the per-centre kernel of
+// apply_hourglass_control): adds its forces to f.force when that is set (the caller keeps two
+// centres that share a node from running at once) and returns their powers; zero powers for a
+// centre that is not controlled. Also the energy booking's pass (drivers.hpp,
+// compute_stress_power) calls it, with no force and power_velocity set, so that the step visits
+// each row once for its stress and hourglass work.
+template <int D>
+HourglassPower hourglass_centre(std::span<const NodeIndex> row, std::size_t i, const HourglassFields<D>& f,
+                                std::size_t real_count, double coefficient);
+
 template <int D>
 void apply_hourglass_control(const CompressedRows& lists, const ScatterPlan& plan, const HourglassFields<D>& f,
                              std::size_t real_count, double coefficient);
