@@ -4,6 +4,7 @@
 #include <atomic>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 #include <string>
 
 #include <fmt/format.h>
@@ -70,6 +71,13 @@ materials::PointResult advance_material_point(const MaterialPointFields& f, std:
     state.damage = f.damage[i];
     state.failed = f.failed[i] != 0;
     const materials::PointResult result = materials::update_point(material, state, increment);
+    if (result.return_iterations > materials::johnson_cook_max_iterations) {
+        // The callers report the first such node after their loop (update_stresses, elements.cpp).
+        throw std::runtime_error(fmt::format(
+            "the Johnson-Cook return did not converge in {} iterations (plastic strain {:.6g}, temperature {:.6g} K, "
+            "time step {:.3g} s)",
+            materials::johnson_cook_max_iterations, f.plastic_strain[i], f.temperature[i], increment.dt));
+    }
     from_material<D>(f, i, state.deviatoric_stress);
     f.pressure[i] = state.pressure;
     f.internal_energy[i] = state.specific_internal_energy;

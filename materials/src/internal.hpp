@@ -55,6 +55,7 @@ struct ReturnResult {
     double plastic_strain_increment = 0.0;  // d eps_p >= 0
     double flow_stress = 0.0;              // Y at the end of the step (0 for an elastic material)
     bool plastic = false;
+    int iterations = 0;  // Johnson-Cook: flow-stress evaluations of the return's iteration (0 otherwise)
 };
 
 // Radial return of the trial deviator to the flow stress of `strength` at plastic strain

@@ -89,6 +89,7 @@ PointResult update_point(const Material& m, PointState& state, const PointIncrem
     double plastic_increment = 0.0;
     double plastic_rate = 0.0;  // d eps_p / dt: the rate of the Johnson-Cook strength and fracture models
     double plastic_power = 0.0;  // s_mid : d eps_p, J/m^3
+    int return_iterations = 0;
     if (!state.failed) {
         Eigen::Matrix3d trial = s_old + inc.dt * (2.0 * m.shear_modulus * d_dev + omega * s_old - s_old * omega);
         trial = (0.5 * (trial + trial.transpose())).eval();  // eval: no aliasing with transpose
@@ -96,6 +97,7 @@ PointResult update_point(const Material& m, PointState& state, const PointIncrem
         const detail::ReturnResult r =
             detail::radial_return(m.strength, trial, m.shear_modulus, state.plastic_strain, inc.dt, t_star);
         s_new = r.deviator;
+        return_iterations = r.iterations;
         plastic_increment = r.plastic_strain_increment;
         plastic_rate = inc.dt > 0.0 ? plastic_increment / inc.dt : 0.0;
         if (plastic_increment > 0.0) {
@@ -182,6 +184,7 @@ PointResult update_point(const Material& m, PointState& state, const PointIncrem
     result.plastic_work = plastic_work;
     result.viscous_work = inc.energy_booked_by_caller ? 0.0 : -q_mid * dv;
     result.plastic_strain_rate = plastic_rate;
+    result.return_iterations = return_iterations;
     return result;
 }
 

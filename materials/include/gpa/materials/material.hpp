@@ -155,7 +155,14 @@ struct PointResult {
     double viscous_work = 0.0;      // increment of specific work done by Q over the step, J/kg (>= 0 in compression)
     double plastic_strain_rate = 0.0;  // equivalent plastic strain rate d eps_p / dt of the step, 1/s
     bool failed_now = false;        // the node failed during this step
+    // Flow-stress evaluations of the Johnson-Cook return (0 for other strengths and elastic steps);
+    // johnson_cook_max_iterations + 1 when the return did not converge within its cap (the caller
+    // reports that: the deviator is then not on the yield surface).
+    int return_iterations = 0;
 };
+
+// The cap on the Johnson-Cook return's iteration (materials/src/strength.cpp explains the bound).
+inline constexpr int johnson_cook_max_iterations = 200;
 
 // Advances one material point over dt (spec section 4):
 //   deviator: Jaumann rate s* = s + dt (2 G D' + Omega s - s Omega), then radial return to the
