@@ -1,5 +1,7 @@
 #include "gpa/engine/hourglass.hpp"
 
+#include <vector>
+
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -77,30 +79,38 @@ HourglassPower hourglass_centre(std::span<const NodeIndex> row, std::size_t i, c
         fit.moment.computeInverseAndDetWithCheck(inverse, determinant, invertible, 1e-12 * std::pow(fit.moment.trace(), D));
         return invertible && fit.weight > 0.0;
     };
+    // The controlled pairs of the row with their offsets and weights, found once for the fit and
+    // used again for the forces (a buffer per thread, reused from centre to centre).
+    struct Pair {
+        NodeIndex j;
+        Vec<D> offset;  // r = x_j - x_i (damping) or dX = X_j - X_i (stiffness)
+        double weight;  // w = W_j / r^2 (damping) or 1 / |dX|^2 (stiffness)
+    };
+    thread_local std::vector<Pair> pairs;
     if (coefficient > 0.0) {
         // Pass 1: the weighted least-squares velocity gradient of the lattice pairs.
+        pairs.clear();
         HourglassFit<D> fit;
         for (NodeIndex j : row) {
             if (!controlled_pair(j)) continue;
             const Vec<D> r = load(f.position, j) - x_i;
-            accumulate_hourglass_fit<D>(r, load(f.velocity, j) - v_i, hourglass_pair_weight(f.size_weight[j], r.squaredNorm()), fit);
+            const double w = hourglass_pair_weight(f.size_weight[j], r.squaredNorm());
+            accumulate_hourglass_fit<D>(r, load(f.velocity, j) - v_i, w, fit);
+            pairs.push_back({j, r, w});
         }
         Mat<D> inverse;
         if (invert(fit, inverse)) {
             const Mat<D> fitted_gradient = fit.difference * inverse;
             const double kappa = hourglass_damping(coefficient, f.mass[i], f.sound_speed[i], f.smallest_h[i]) / fit.weight;
             // Pass 2: F_j = - kappa w_j e_ij on the neighbour, the reaction on the centre.
-            for (NodeIndex j : row) {
-                if (!controlled_pair(j)) continue;
-                const Vec<D> r = load(f.position, j) - x_i;
-                const Vec<D> dv = load(f.velocity, j) - v_i;
-                const Vec<D> force_on_j = (-kappa * hourglass_pair_weight(f.size_weight[j], r.squaredNorm())) *
-                                          hourglass_velocity_error<D>(fitted_gradient, r, dv);
+            for (const Pair& p : pairs) {
+                const Vec<D> dv = load(f.velocity, p.j) - v_i;
+                const Vec<D> force_on_j = (-kappa * p.weight) * hourglass_velocity_error<D>(fitted_gradient, p.offset, dv);
                 if (scatter) {
-                    for (int c = 0; c < D; ++c) f.force[c][j] += force_on_j[c];
+                    for (int c = 0; c < D; ++c) f.force[c][p.j] += force_on_j[c];
                 }
                 on_centre -= force_on_j;
-                out.damping += power_of(j, force_on_j, dv);
+                out.damping += power_of(p.j, force_on_j, dv);
             }
         }
     }
@@ -108,26 +118,27 @@ HourglassPower hourglass_centre(std::span<const NodeIndex> row, std::size_t i, c
         // The stiffness form (kernels.hpp, hourglass_stiffness): the affine map of the initial
         // lattice pairs that fits their current offsets best, then forces against the rest.
         const Vec<D> x0_i = load(f.initial_position, i);
+        pairs.clear();
         HourglassFit<D> fit;
         for (NodeIndex j : row) {
             if (!stiff_pair(j)) continue;
             const Vec<D> initial = load(f.initial_position, j) - x0_i;
-            accumulate_hourglass_fit<D>(initial, load(f.position, j) - x_i, hourglass_pair_weight(1.0, initial.squaredNorm()), fit);
+            const double w = hourglass_pair_weight(1.0, initial.squaredNorm());
+            accumulate_hourglass_fit<D>(initial, load(f.position, j) - x_i, w, fit);
+            pairs.push_back({j, initial, w});
         }
         Mat<D> inverse;
         if (invert(fit, inverse)) {
             const Mat<D> fitted_map = fit.difference * inverse;
             const double k = hourglass_stiffness(f.stiffness, f.mass[i], f.sound_speed[i], f.initial_diameter[i]) / fit.weight;
-            for (NodeIndex j : row) {
-                if (!stiff_pair(j)) continue;
-                const Vec<D> initial = load(f.initial_position, j) - x0_i;
-                const Vec<D> force_on_j = (-k * hourglass_pair_weight(1.0, initial.squaredNorm())) *
-                                          hourglass_displacement_error<D>(fitted_map, initial, load(f.position, j) - x_i);
+            for (const Pair& p : pairs) {
+                const Vec<D> force_on_j = (-k * p.weight) *
+                                          hourglass_displacement_error<D>(fitted_map, p.offset, load(f.position, p.j) - x_i);
                 if (scatter) {
-                    for (int c = 0; c < D; ++c) f.force[c][j] += force_on_j[c];
+                    for (int c = 0; c < D; ++c) f.force[c][p.j] += force_on_j[c];
                 }
                 on_centre -= force_on_j;
-                out.stiffness += power_of(j, force_on_j, load(f.velocity, j) - v_i);
+                out.stiffness += power_of(p.j, force_on_j, load(f.velocity, p.j) - v_i);
             }
         }
     }

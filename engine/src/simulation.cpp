@@ -31,6 +31,7 @@
 #include "gpa/engine/state_io.hpp"
 #include "gpa/engine/stress.hpp"
 #include "gpa/engine/version.hpp"
+#include "step/regions.hpp"
 
 namespace gpa {
 
@@ -161,16 +162,7 @@ struct Simulation::Impl {
     double boundary_work = 0.0;
     std::vector<double> impulse;
     std::vector<double> reaction;
-    // Prescribed-velocity regions (prescribed.hpp). A scene is all particles or all elements, so
-    // one of the two sets of held nodes is empty. Per region: the nodes it holds, the work of its
-    // constraint up to the last one (through v^{n+3/2}), the last step's reaction and work, the
-    // impulse given since t = 0 and the displacement of its nodes.
-    HeldNodes held_particles, held_elements;
-    std::vector<std::uint8_t> held_bits;  // per real node: its region's held components (for smoothing)
-    std::vector<std::size_t> region_nodes;
-    std::vector<double> region_work;
-    std::vector<RegionStep> region_last;
-    std::vector<std::array<double, 3>> region_impulse, region_displacement;
+    Regions regions;  // prescribed-velocity regions (step/regions.hpp)
     Totals totals;
     std::string stop_reason;
 
@@ -181,7 +173,8 @@ struct Simulation::Impl {
     void write_state(StateWriter& out) const;
     void read_state(StateReader& in);
 
-    Impl(Scene s, int thread_count) : scene(std::move(s)), threads(thread_count), nodes(scene.geometry) {}
+    Impl(Scene s, int thread_count)
+        : scene(std::move(s)), threads(thread_count), nodes(scene.geometry), regions(scene.prescribed_velocities) {}
 
     int dim() const { return nodes.dim(); }
     double a() const { return scene.solver.influence_distance; }
@@ -220,10 +213,6 @@ struct Simulation::Impl {
     std::array<std::vector<double>, 3> half_velocity;  // v^{n+1/2} of the real nodes, for the hourglass heat
     template <class G>
     void smoothing();
-    void assign_regions();
-    void index_regions();
-    void book_regions(const std::vector<RegionStep>& step, double dt_avg);
-    void advance_region_displacements(double dt);
     void sum_totals();
     void sum_body_totals(bool advance_kinetic, const Sums* particle_sums = nullptr);
     measure::Extent element_extent(const GhostPlane& plane, bool axisymmetric, double base = 0.0) const;
@@ -259,7 +248,7 @@ void Simulation::Impl::setup() {
         elements = std::make_unique<ElementPart>(scene, mesh_element_bodies(scene), element_options(scene));
     }
     validate_nodes(nodes, 0, real);
-    assign_regions();
+    regions.assign(scene, nodes, real, elements ? &elements->mesh().nodes : nullptr);
     // Nodes of variable-connectivity bodies never read their lattice lists: drop them (memory).
     const auto drop_variable_rows = [&](CompressedRows& rows, std::vector<std::uint8_t>* tags) {
         CompressedRows kept;
@@ -313,7 +302,7 @@ void Simulation::Impl::setup() {
     }
     if (particles && scene.solver.reorder_interval > 0) reorder();
     regroup_materials();
-    index_regions();
+    regions.index(nodes, real);
     separate_failed = scene.solver.failure && scene.solver.separate_failed;
     with_separation = scene.bodies.size() > 1 || separate_failed;
     sliding_contact = with_separation && scene.solver.sliding_contact;
@@ -367,7 +356,7 @@ void Simulation::Impl::reorder() {
     lists.clear();  // rebuilt in the new numbering by the neighbours phase
     search_due = true;
     regroup_materials();
-    index_regions();
+    regions.index(nodes, real);
 }
 
 void Simulation::Impl::move() {
@@ -380,7 +369,7 @@ void Simulation::Impl::move() {
             for (std::size_t i = r.begin(); i != r.end(); ++i) x[i] += dt * v[i];
         }
     });
-    advance_region_displacements(dt);
+    regions.advance_displacements(dim(), time, dt);
     time += dt;
     // Penetration guard: a node that ends behind a plane is put back just in front of it and
     // loses its velocity towards it; the kinetic energy and momentum it loses are booked as
@@ -780,8 +769,8 @@ void Simulation::Impl::book_stress_work(double dt_avg) {
     // Held components (prescribed.hpp) went from v^{n+1/2} to the prescribed v^{n+3/2}, not by
     // dt_avg F / M: their mean is that of the two, so that the regions' work (the reaction's, at the
     // same mean) and this booking together give their kinetic-energy change exactly.
-    if (!held_particles.empty()) {
-        held_particles.set_mean_velocity(scene.prescribed_velocities, d,
+    if (const HeldNodes& held = regions.particles(); !held.empty()) {
+        held.set_mean_velocity(scene.prescribed_velocities, d,
                                          {nodes.velocity[0].data(), nodes.velocity[1].data(), d == 3 ? nodes.velocity[2].data() : nullptr},
                                          {mean_velocity[0].data(), mean_velocity[1].data(), d == 3 ? mean_velocity[2].data() : nullptr});
     }
@@ -828,7 +817,8 @@ void Simulation::Impl::integrate(double dt_avg) {
     const int d = dim();
     const std::array<double*, 3> velocity{nodes.velocity[0].data(), nodes.velocity[1].data(),
                                           d == 3 ? nodes.velocity[2].data() : nullptr};
-    if (!held_particles.empty()) held_particles.capture({velocity[0], velocity[1], velocity[2]}, d);
+    HeldNodes& held = regions.particles();
+    if (!held.empty()) held.capture({velocity[0], velocity[1], velocity[2]}, d);
     if (compatible_energy && with_hourglass) {
         // The half-step velocities the hourglass forces were made from (book_stress_work).
         for (int c = 0; c < d; ++c) half_velocity[c].assign(nodes.velocity[c].begin(), nodes.velocity[c].begin() + real);
@@ -840,9 +830,8 @@ void Simulation::Impl::integrate(double dt_avg) {
             for (std::size_t i = r.begin(); i != r.end(); ++i) v[i] += dt_avg * f[i] / nodes.mass[i];
         }
     });
-    if (!held_particles.empty()) {
-        book_regions(held_particles.impose(scene.prescribed_velocities, d, time + 0.5 * dt_next, dt_avg, velocity, nodes.mass.data()),
-                     dt_avg);
+    if (!held.empty()) {
+        regions.book(held.impose(scene.prescribed_velocities, d, time + 0.5 * dt_next, dt_avg, velocity, nodes.mass.data()), dt_avg);
     }
     for (std::size_t k = 0; k < reaction.size(); ++k) impulse[k] += reaction[k] * dt_avg;
     if (compatible_energy && particles) book_stress_work<G>(dt_avg);
@@ -894,114 +883,23 @@ void Simulation::Impl::integrate_elements(double dt_avg, double dt_next_step) {
     // contact), then the prescribed components.
     ElementNodes& n = elements->mesh().nodes;
     const std::array<double*, 3> velocity{n.velocity[0].data(), n.velocity[1].data(), nullptr};
-    if (!held_elements.empty()) held_elements.capture({velocity[0], velocity[1], nullptr}, 2);
+    HeldNodes& held = regions.elements();
+    if (!held.empty()) held.capture({velocity[0], velocity[1], nullptr}, 2);
     elements->integrate(dt_avg, dt_next_step);
-    if (!held_elements.empty()) {
-        book_regions(held_elements.impose(scene.prescribed_velocities, 2, time + 0.5 * dt_next_step, dt_avg, velocity, n.mass.data()),
-                     dt_avg);
+    if (!held.empty()) {
+        regions.book(held.impose(scene.prescribed_velocities, 2, time + 0.5 * dt_next_step, dt_avg, velocity, n.mass.data()), dt_avg);
     }
 }
 
 template <class G>
 void Simulation::Impl::smoothing() {
     SmoothingOptions o{scene.solver.smoothing_coefficient, scene.solver.smoothing == SmoothingMode::Tension};
-    if (!held_particles.empty()) o.held = held_bits.data();
+    o.held = regions.held_bits();
     std::array<double*, G::dim> v{};
     for (int c = 0; c < G::dim; ++c) v[c] = nodes.velocity[c].data();
     smooth_velocities<G>(lists, plan, scene.solver.weight, with_contact(pair_fields<G::dim>(nodes, a())), real, o, v,
                          nodes.mass.data(), nodes.pressure.data(), nodes.internal_energy.data(), smoothing_scratch);
-    // The momentum that smoothing would have moved into held components (and that the free
-    // nodes got instead) comes from the regions (smoothing.hpp).
-    const auto& nodes_of = held_particles.nodes();
-    for (std::size_t k = 0; k + 1 < nodes_of.offsets.size(); ++k) {
-        const auto& spec = scene.prescribed_velocities[k];
-        for (const NodeIndex i : nodes_of.row(k)) {
-            for (int c = 0; c < G::dim; ++c) {
-                if (spec.velocity[c]) region_impulse[k][c] -= nodes.mass[i] * smoothing_scratch.total_change[G::dim * i + c];
-            }
-        }
-    }
-}
-
-void Simulation::Impl::assign_regions() {
-    // Every node of a region's body inside it at t = 0 (scene.hpp; validate_scene has checked that
-    // each region holds nodes and that no two share one), at the velocity prescribed at t = 0.
-    const auto& regions = scene.prescribed_velocities;
-    const std::size_t count = regions.size();
-    region_nodes.assign(count, 0);
-    region_work.assign(count, 0.0);
-    region_last.assign(count, RegionStep{});
-    region_impulse.assign(count, {0.0, 0.0, 0.0});
-    region_displacement.assign(count, {0.0, 0.0, 0.0});
-    std::vector<std::uint8_t> element_region(elements ? elements->mesh().nodes.size() : 0, 0);
-    const int d = dim();
-    for (std::size_t k = 0; k < count; ++k) {
-        const auto& spec = regions[k];
-        std::size_t b = 0;
-        while (b < scene.bodies.size() && scene.bodies[b].name != spec.body) ++b;
-        if (b == scene.bodies.size()) throw InputError(fmt::format("prescribed velocity {}: unknown body \"{}\"", k, spec.body));
-        const auto axis = body_axis(scene, b);
-        const auto hold = [&](std::uint8_t& region_of, std::array<double*, 3> v, std::size_t i, const std::array<double, 3>& p) {
-            if (!in_region(spec, scene.geometry, axis, p)) return;
-            if (region_of != 0) {
-                throw InputError(fmt::format("prescribed velocities \"{}\" and \"{}\" share node {}", regions[region_of - 1u].name,
-                                             spec.name, i));
-            }
-            region_of = static_cast<std::uint8_t>(k + 1);
-            ++region_nodes[k];
-            for (int c = 0; c < d; ++c) {
-                if (spec.velocity[c]) v[c][i] = prescribed_velocity(spec, c, 0.0);
-            }
-        };
-        for (std::size_t i = 0; i < real; ++i) {
-            if (nodes.body[i] != static_cast<std::int32_t>(b)) continue;
-            std::array<double, 3> p{0, 0, 0};
-            for (int c = 0; c < d; ++c) p[c] = nodes.initial_position[c][i];
-            hold(nodes.velocity_region[i], {nodes.velocity[0].data(), nodes.velocity[1].data(), d == 3 ? nodes.velocity[2].data() : nullptr},
-                 i, p);
-        }
-        if (elements) {
-            ElementNodes& n = elements->mesh().nodes;
-            for (std::size_t i = 0; i < n.size(); ++i) {
-                if (n.body[i] != static_cast<std::int32_t>(b)) continue;
-                hold(element_region[i], {n.velocity[0].data(), n.velocity[1].data(), nullptr}, i, {n.position[0][i], n.position[1][i], 0.0});
-            }
-        }
-        if (region_nodes[k] == 0) {
-            throw InputError(fmt::format("prescribed velocity \"{}\": its region holds no node of body \"{}\"", spec.name, spec.body));
-        }
-    }
-    if (elements) held_elements.index(element_region.data(), element_region.size(), count);
-}
-
-void Simulation::Impl::index_regions() {
-    // The held particle nodes by region, and their held components per node (smoothing), in the
-    // current node numbering: after the set-up, every reordering and a restore.
-    const auto& regions = scene.prescribed_velocities;
-    if (regions.empty()) return;
-    held_particles.index(nodes.velocity_region.data(), real, regions.size());
-    held_bits.assign(real, 0);
-    for (std::size_t i = 0; i < real; ++i) {
-        if (const std::uint8_t k = nodes.velocity_region[i]; k != 0) held_bits[i] = held_components(regions[k - 1u]);
-    }
-}
-
-void Simulation::Impl::book_regions(const std::vector<RegionStep>& step, double dt_avg) {
-    for (std::size_t k = 0; k < step.size(); ++k) {
-        region_work[k] += step[k].work;
-        for (int c = 0; c < 3; ++c) region_impulse[k][c] += step[k].reaction[c] * dt_avg;
-    }
-    region_last = step;
-}
-
-void Simulation::Impl::advance_region_displacements(double dt) {
-    // The held nodes move with v^{n+1/2}, the velocity the last constraint set at t^n + dt^{n+1/2} / 2.
-    for (std::size_t k = 0; k < region_displacement.size(); ++k) {
-        const auto& spec = scene.prescribed_velocities[k];
-        for (int c = 0; c < dim(); ++c) {
-            if (spec.velocity[c]) region_displacement[k][c] += dt * prescribed_velocity(spec, c, time + 0.5 * dt);
-        }
-    }
+    regions.book_smoothing(G::dim, nodes.mass.data(), smoothing_scratch.total_change);
 }
 
 void Simulation::Impl::sum_body_totals(bool advance_kinetic, const Sums* particle_sums) {
@@ -1141,23 +1039,7 @@ void Simulation::Impl::sum_totals() {
     // t^{n+3/2}, so half of the last update's work is done by then (and none at t = 0). Either way
     // a rigid motion's energy books close to round-off.
     const bool balance_at_half_step = compatible_energy && !elements;
-    double region_work_now = 0.0;
-    totals.regions.resize(scene.prescribed_velocities.size());
-    for (std::size_t k = 0; k < totals.regions.size(); ++k) {
-        const auto& spec = scene.prescribed_velocities[k];
-        RegionReport& r = totals.regions[k];
-        r.name = spec.name;
-        r.nodes = region_nodes[k];
-        r.work = balance_at_half_step ? region_work[k] : steps == 0 && time == 0.0 ? 0.0 : region_work[k] - 0.5 * region_last[k].work;
-        for (int c = 0; c < 3; ++c) {
-            r.held[c] = spec.velocity[c].has_value();
-            r.velocity[c] = prescribed_velocity(spec, c, time);
-            r.displacement[c] = region_displacement[k][c];
-            r.reaction[c] = region_last[k].reaction[c];
-            r.impulse[c] = region_impulse[k][c];
-        }
-        region_work_now += r.work;
-    }
+    const double region_work_now = regions.report(time, balance_at_half_step, steps == 0 && time == 0.0, totals.regions);
     totals.boundary_work = boundary_work + element_boundary_work - region_work_now;
     totals.momentum = all.momentum;
     totals.time = time;
@@ -1243,7 +1125,7 @@ void Simulation::Impl::build_phase_graph() {
         graph->add("element move", [this] {
             elements->move(dt_half);
             if (!particles) {
-                advance_region_displacements(dt_half);
+                regions.advance_displacements(2, time, dt_half);
                 time += dt_half;
             }
         });
@@ -1663,16 +1545,7 @@ void Simulation::Impl::write_state(StateWriter& out) const {
     for (const auto& b : totals.bodies) out.value<double>(b.kinetic_energy);
     out.array(impulse);
     out.array(reaction);
-    out.tag("PVEL");
-    out.array(region_work);
-    for (std::size_t k = 0; k < region_work.size(); ++k) {
-        for (int c = 0; c < 3; ++c) {
-            out.value<double>(region_last[k].reaction[c]);
-            out.value<double>(region_impulse[k][c]);
-            out.value<double>(region_displacement[k][c]);
-        }
-        out.value<double>(region_last[k].work);
-    }
+    regions.write_state(out);
     out.tag("TOTL");
     const Totals& t = totals;
     for (const double v : {t.time, t.time_step, t.kinetic_energy, t.internal_energy, t.plastic_work, t.viscous_work,
@@ -1748,18 +1621,8 @@ void Simulation::Impl::read_state(StateReader& in) {
     in.array(impulse);
     in.array(reaction);
     if (impulse.size() != rigid_planes.size() || reaction.size() != rigid_planes.size()) in.fail("its planes are not the scene's");
-    in.tag("PVEL");
-    in.array(region_work);
-    const std::size_t regions = scene.prescribed_velocities.size();
-    if (region_work.size() != regions) in.fail("its prescribed velocities are not the scene's");
-    for (std::size_t k = 0; k < regions; ++k) {
-        for (int c = 0; c < 3; ++c) {
-            region_last[k].reaction[c] = in.value<double>();
-            region_impulse[k][c] = in.value<double>();
-            region_displacement[k][c] = in.value<double>();
-        }
-        region_last[k].work = in.value<double>();
-    }
+    regions.read_state(in);
+    const std::size_t region_count = scene.prescribed_velocities.size();
     in.tag("TOTL");
     Totals& t = totals;
     for (double* v : {&t.time, &t.time_step, &t.kinetic_energy, &t.internal_energy, &t.plastic_work, &t.viscous_work,
@@ -1779,8 +1642,8 @@ void Simulation::Impl::read_state(StateReader& in) {
         p.reaction = in.value<double>();
         p.impulse = in.value<double>();
     }
-    if (in.value<std::uint64_t>() != regions) in.fail("its prescribed velocities are not the scene's");
-    t.regions.resize(regions);
+    if (in.value<std::uint64_t>() != region_count) in.fail("its prescribed velocities are not the scene's");
+    t.regions.resize(region_count);
     for (auto& r : t.regions) {
         r.name = in.text();
         r.nodes = static_cast<std::size_t>(in.value<std::uint64_t>());
@@ -1804,13 +1667,7 @@ void Simulation::Impl::read_state(StateReader& in) {
     sum_body_totals(false);
     for (std::size_t b = 0; b < body_kinetic.size(); ++b) totals.bodies[b].kinetic_energy = body_kinetic[b];
     // The held nodes in the checkpoint's numbering: the same count per region as the scene's.
-    for (std::size_t i = 0; i < real; ++i) {
-        if (nodes.velocity_region[i] > regions) in.fail("a node is held by a prescribed velocity the scene does not have");
-    }
-    index_regions();
-    for (std::size_t k = 0; k < regions; ++k) {
-        if (held_particles.nodes().row_size(k) != region_nodes[k]) in.fail("its prescribed velocities hold other nodes than the scene's");
-    }
+    regions.check_restored(in, nodes, real);
 }
 
 bool Simulation::can_checkpoint() const { return !impl_->elements; }
