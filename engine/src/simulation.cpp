@@ -31,6 +31,7 @@
 #include "gpa/engine/state_io.hpp"
 #include "gpa/engine/stress.hpp"
 #include "gpa/engine/version.hpp"
+#include "step/energy_ledger.hpp"
 #include "step/regions.hpp"
 
 namespace gpa {
@@ -94,8 +95,6 @@ struct Simulation::Impl {
     std::vector<double> searched_diameter;
     ScatterPlan plan;
     SmoothingScratch smoothing_scratch;
-    std::vector<double> bond_power;
-    bool with_hourglass = false;         // C_hg > 0 or C_hs > 0
     // Separable pairs (separation.hpp): between bodies, and through failed nodes when failure is on
     // and solver.separate_failed; decided every step before the velocity gradient.
     bool with_separation = false;
@@ -141,11 +140,7 @@ struct Simulation::Impl {
     ImpactFrame impact;                    // body_report.hpp, from the initial state
     std::vector<double> body_kinetic_half; // per body, like kinetic_half
     bool any_automatic = false;          // some body switches fixed nodes to variable
-    std::vector<double> hourglass_power; // per centre, the power of its hourglass-control forces
-    std::vector<double> hourglass_stiffness_power; // per centre, the power of its hourglass-stiffness forces (C_hs > 0)
     std::vector<double> cell_ratio;      // per node, its smallest lattice-cell volume ratio (lattice_check.hpp)
-    double hourglass_work = 0.0;
-    double hourglass_energy = 0.0;  // work of the hourglass stiffness, booked as internal energy
     std::vector<double> largest_bond_q;  // per centre, the largest Q_ij of its pairs (for the time step)
     bool failed = false;                 // a phase threw: the state is half-updated
     std::unique_ptr<PhaseGraph> graph;
@@ -159,10 +154,10 @@ struct Simulation::Impl {
     std::size_t steps = 0;
     double node_steps = 0.0;
     double kinetic_half = 0.0;  // kinetic energy of the current half-step velocities
-    double boundary_work = 0.0;
     std::vector<double> impulse;
     std::vector<double> reaction;
-    Regions regions;  // prescribed-velocity regions (step/regions.hpp)
+    Regions regions;      // prescribed-velocity regions (step/regions.hpp)
+    EnergyLedger ledger;  // every booking of work and heat (step/energy_ledger.hpp)
     Totals totals;
     std::string stop_reason;
 
@@ -174,7 +169,11 @@ struct Simulation::Impl {
     void read_state(StateReader& in);
 
     Impl(Scene s, int thread_count)
-        : scene(std::move(s)), threads(thread_count), nodes(scene.geometry), regions(scene.prescribed_velocities) {}
+        : scene(std::move(s)),
+          threads(thread_count),
+          nodes(scene.geometry),
+          regions(scene.prescribed_velocities),
+          ledger(scene.solver) {}
 
     int dim() const { return nodes.dim(); }
     double a() const { return scene.solver.influence_distance; }
@@ -206,11 +205,7 @@ struct Simulation::Impl {
     void integrate(double dt_avg);
     void integrate_elements(double dt_avg, double dt_next);
     template <class G>
-    void book_stress_work(double dt_avg);
-    bool compatible_energy = true;                     // SolverOptions::energy_update
-    std::array<std::vector<double>, 3> mean_velocity;  // scratch of book_stress_work
-    std::vector<double> stress_power, viscous_power;   // per real node, ditto
-    std::array<std::vector<double>, 3> half_velocity;  // v^{n+1/2} of the real nodes, for the hourglass heat
+    HourglassFields<G::dim> hourglass_control_fields(double* power, double* stiffness_power);
     template <class G>
     void smoothing();
     void sum_totals();
@@ -311,8 +306,6 @@ void Simulation::Impl::setup() {
                      std::none_of(body_mode.begin(), body_mode.end(),
                                   [](ConnectivityMode m) { return m == ConnectivityMode::Automatic; });
     with_skin = scene.solver.neighbour_skin > 0.0 && !lists_constant;
-    with_hourglass = scene.solver.hourglass_coefficient > 0.0 || scene.solver.hourglass_stiffness > 0.0;
-    compatible_energy = scene.solver.energy_update == EnergyUpdate::Compatible;
     any_automatic = std::any_of(body_mode.begin(), body_mode.end(), [](ConnectivityMode m) { return m == ConnectivityMode::Automatic; });
 
     // Geometry, neighbours, geometry factors and forces at t = 0; then the first half step.
@@ -396,7 +389,7 @@ void Simulation::Impl::move() {
                 return acc;
             },
             [](WorkAndImpulse x, const WorkAndImpulse& y) { return WorkAndImpulse{x[0] + y[0], x[1] + y[1]}; });
-        boundary_work += lost[0];
+        ledger.add_boundary_work(lost[0]);
         if (rigid != rigid_planes.end()) impulse[rigid - rigid_planes.begin()] += lost[1];
     }
 }
@@ -592,7 +585,7 @@ void Simulation::Impl::stress() {
     o.viscosity_linear = scene.solver.viscosity_linear;
     o.viscosity_quadratic = scene.solver.viscosity_quadratic;
     o.failure = scene.solver.failure;
-    o.energy_booked_by_forces = compatible_energy;
+    o.energy_booked_by_forces = ledger.compatible();
     update_stresses<G>(nodes, real, scene.materials, material_groups, dt_half, o);
 }
 
@@ -726,19 +719,15 @@ void Simulation::Impl::forces() {
     const bool with_bond = scene.solver.viscosity == ViscosityKind::Bond;
     if (with_bond) {
         f.viscous_pressure = nullptr;
-        bond_power.assign(nodes.size(), 0.0);
-        f.bond_viscous_power = bond_power.data();
+        f.bond_viscous_power = ledger.bond_power(nodes.size());
         largest_bond_q.assign(nodes.size(), 0.0);
         f.largest_bond_viscosity = largest_bond_q.data();
     }
     compute_forces<G>(lists, plan, scene.solver.weight, with_bond ? &bond : nullptr, f, nodes.size());
-    if (with_hourglass) {
-        hourglass_power.assign(nodes.size(), 0.0);
-        hourglass_stiffness_power.assign(nodes.size(), 0.0);
-        auto h = hourglass_fields<G::dim>(nodes, scene.solver.switch_plastic_strain, hourglass_power.data(),
-                                          scene.solver.hourglass_stiffness, hourglass_stiffness_power.data());
-        if (sliding_contact && separate_failed) h.failed = nodes.failed.data();
-        apply_hourglass_control<G::dim>(lists, plan, h, real, scene.solver.hourglass_coefficient);
+    if (ledger.hourglass()) {
+        apply_hourglass_control<G::dim>(lists, plan,
+                                        hourglass_control_fields<G>(ledger.hourglass_power(nodes.size()), ledger.stiffness_power(nodes.size())),
+                                        real, scene.solver.hourglass_coefficient);
     }
     if (!ghosts.empty()) {
         const auto all = ghosts.normal_reactions(nodes, real);
@@ -747,82 +736,27 @@ void Simulation::Impl::forces() {
 }
 
 template <class G>
-void Simulation::Impl::book_stress_work(double dt_avg) {
-    // Spec section 5, "[spec] Compatible energy": the internal energy of a node changes by the work
-    // its stress forces do in this velocity update, at the mean of the half-step velocities before
-    // and after it, v_mean = v^{n+3/2} - dt_avg F / (2 M): exactly the kinetic energy those forces
-    // add, so the spatial and the time discretisation conserve energy together. (The point update's
-    // own energy equation uses the strain rate of the geometry one step earlier than the forces; the
-    // difference is first order in dt wherever stress and strain rate are large at once: +3 % of the
-    // energy within 0.4 us of a 4 km/s impact at C_cfl 0.4, +1.5 % at 0.2.)
-    const std::size_t n = nodes.size();
-    const int d = dim();
-    for (int c = 0; c < d; ++c) resize_with_slack(mean_velocity[c], n);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, real, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
-        for (int c = 0; c < d; ++c) {
-            const double* v = nodes.velocity[c].data();
-            const double* f = nodes.force[c].data();
-            double* mean = mean_velocity[c].data();
-            for (std::size_t i = r.begin(); i != r.end(); ++i) mean[i] = v[i] - 0.5 * dt_avg * f[i] / nodes.mass[i];
-        }
-    });
-    // Held components (prescribed.hpp) went from v^{n+1/2} to the prescribed v^{n+3/2}, not by
-    // dt_avg F / M: their mean is that of the two, so that the regions' work (the reaction's, at the
-    // same mean) and this booking together give their kinetic-energy change exactly.
-    if (const HeldNodes& held = regions.particles(); !held.empty()) {
-        held.set_mean_velocity(scene.prescribed_velocities, d,
-                                         {nodes.velocity[0].data(), nodes.velocity[1].data(), d == 3 ? nodes.velocity[2].data() : nullptr},
-                                         {mean_velocity[0].data(), mean_velocity[1].data(), d == 3 ? mean_velocity[2].data() : nullptr});
-    }
-    if (!ghosts.empty()) {
-        ghosts.mirror_vector_field({mean_velocity[0].data(), mean_velocity[1].data(), d == 3 ? mean_velocity[2].data() : nullptr},
-                                   d, real);
-    }
-    std::array<const double*, G::dim> mean{};
-    for (int c = 0; c < G::dim; ++c) mean[c] = mean_velocity[c].data();
-    stress_power.resize(real);
-    viscous_power.resize(real);
-    auto f = force_fields<G::dim>(nodes, a());
-    f.pairs = with_contact(f.pairs);
-    f.full_normalisation = scene.solver.normalisation == Normalisation::MomentMatrix;
-    if (scene.solver.viscosity != ViscosityKind::Nodal) f.viscous_pressure = nullptr;  // as in forces()
-    // The hourglass forces' power in the same pass (from the half-step velocities, as in forces(),
-    // their power taken at the mean velocities: the kinetic energy they remove in this update).
-    std::optional<HourglassFields<G::dim>> h;
-    if (with_hourglass) {
-        h = hourglass_fields<G::dim>(nodes, scene.solver.switch_plastic_strain, hourglass_power.data(),
-                                     scene.solver.hourglass_stiffness, hourglass_stiffness_power.data());
-        if (sliding_contact && separate_failed) h->failed = nodes.failed.data();
-        for (int c = 0; c < G::dim; ++c) {
-            h->velocity[c] = half_velocity[c].data();
-            h->force[c] = nullptr;
-            h->power_velocity[c] = mean[c];
-        }
-    }
-    compute_stress_power<G>(lists, scene.solver.weight, f, mean, real, stress_power.data(), viscous_power.data(),
-                            h ? &*h : nullptr, scene.solver.hourglass_coefficient);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, real, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
-        for (std::size_t i = r.begin(); i != r.end(); ++i) {
-            nodes.internal_energy[i] -= stress_power[i] * dt_avg / nodes.mass[i];
-            nodes.viscous_work[i] -= viscous_power[i] * dt_avg / nodes.mass[i];
-        }
-    });
+HourglassFields<G::dim> Simulation::Impl::hourglass_control_fields(double* power, double* stiffness_power) {
+    // The hourglass control's fields (hourglass.hpp), its powers per centre into `power` and
+    // `stiffness_power`.
+    auto h = hourglass_fields<G::dim>(nodes, scene.solver.switch_plastic_strain, power, scene.solver.hourglass_stiffness,
+                                      stiffness_power);
+    if (sliding_contact && separate_failed) h.failed = nodes.failed.data();
+    return h;
 }
 
 template <class G>
 void Simulation::Impl::integrate(double dt_avg) {
     // v^{n+3/2} = v^{n+1/2} + dt_avg F^{n+1} / M (spec section 11), then the prescribed components
     // of held nodes (prescribed.hpp): after the update, which they replace, and before smoothing,
-    // which leaves them alone, so that the nodes move with the prescribed velocity.
+    // which leaves them alone, so that the nodes move with the prescribed velocity. Then the
+    // ledger books the step's work and heat.
     const int d = dim();
     const std::array<double*, 3> velocity{nodes.velocity[0].data(), nodes.velocity[1].data(),
                                           d == 3 ? nodes.velocity[2].data() : nullptr};
     HeldNodes& held = regions.particles();
     if (!held.empty()) held.capture({velocity[0], velocity[1], velocity[2]}, d);
-    if (compatible_energy && with_hourglass) {
-        // The half-step velocities the hourglass forces were made from (book_stress_work).
-        for (int c = 0; c < d; ++c) half_velocity[c].assign(nodes.velocity[c].begin(), nodes.velocity[c].begin() + real);
-    }
+    ledger.keep_half_step_velocities(nodes, real);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, real, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
         for (int c = 0; c < d; ++c) {
             double* v = nodes.velocity[c].data();
@@ -834,48 +768,17 @@ void Simulation::Impl::integrate(double dt_avg) {
         regions.book(held.impose(scene.prescribed_velocities, d, time + 0.5 * dt_next, dt_avg, velocity, nodes.mass.data()), dt_avg);
     }
     for (std::size_t k = 0; k < reaction.size(); ++k) impulse[k] += reaction[k] * dt_avg;
-    if (compatible_energy && particles) book_stress_work<G>(dt_avg);
-    if (scene.solver.viscosity == ViscosityKind::Bond) {
-        // The work of the bond-viscous forces becomes internal energy of the centre (spec section 5).
-        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, real, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
-            for (std::size_t i = r.begin(); i != r.end(); ++i) {
-                const double heat = -bond_power[i] * dt_avg / nodes.mass[i];
-                nodes.internal_energy[i] += heat;
-                nodes.viscous_work[i] += heat;
-            }
-        });
+    if (ledger.compatible() && particles) {
+        auto f = force_fields<G::dim>(nodes, a());
+        f.pairs = with_contact(f.pairs);
+        f.full_normalisation = scene.solver.normalisation == Normalisation::MomentMatrix;
+        if (scene.solver.viscosity != ViscosityKind::Nodal) f.viscous_pressure = nullptr;  // as in forces()
+        std::optional<HourglassFields<G::dim>> control;
+        if (ledger.hourglass()) control = hourglass_control_fields<G>(nullptr, nullptr);  // the ledger sets the outputs
+        ledger.compatible_powers<G>(lists, scene.solver.weight, f, control, scene.solver.hourglass_coefficient, nodes, real,
+                                    dt_avg, held, scene.prescribed_velocities, ghosts);
     }
-    if (with_hourglass) {
-        // The power the hourglass-control forces dissipate becomes heat of their centre, the same
-        // booking as bond viscosity (kernels.hpp: it is <= 0 pair by pair).
-        hourglass_work += tbb::parallel_deterministic_reduce(
-            tbb::blocked_range<std::size_t>(0, real, reduce_grain), 0.0,
-            [&](const tbb::blocked_range<std::size_t>& r, double sum) {
-                for (std::size_t i = r.begin(); i != r.end(); ++i) {
-                    const double heat = -hourglass_power[i] * dt_avg;
-                    nodes.internal_energy[i] += heat / nodes.mass[i];
-                    nodes.viscous_work[i] += heat / nodes.mass[i];
-                    sum += heat;
-                }
-                return sum;
-            },
-            [](double x, double y) { return x + y; });
-        if (scene.solver.hourglass_stiffness > 0.0) {
-            // The stiffness forces store energy rather than dissipate it: their work is internal
-            // energy of the centre (kernels.hpp, hourglass_stiffness), not viscous work.
-            hourglass_energy += tbb::parallel_deterministic_reduce(
-                tbb::blocked_range<std::size_t>(0, real, reduce_grain), 0.0,
-                [&](const tbb::blocked_range<std::size_t>& r, double sum) {
-                    for (std::size_t i = r.begin(); i != r.end(); ++i) {
-                        const double stored = -hourglass_stiffness_power[i] * dt_avg;
-                        nodes.internal_energy[i] += stored / nodes.mass[i];
-                        sum += stored;
-                    }
-                    return sum;
-                },
-                [](double x, double y) { return x + y; });
-        }
-    }
+    ledger.book(nodes, real, dt_avg);
 }
 
 void Simulation::Impl::integrate_elements(double dt_avg, double dt_next_step) {
@@ -1030,17 +933,17 @@ void Simulation::Impl::sum_totals() {
     totals.internal_energy = all.internal;
     totals.plastic_work = all.plastic;
     totals.viscous_work = all.viscous;
-    totals.hourglass_work = hourglass_work;
-    totals.hourglass_energy = hourglass_energy;
+    totals.hourglass_work = ledger.hourglass_work();
+    totals.hourglass_energy = ledger.hourglass_energy();
     // The regions' work, taken at the instant of the energy balance's kinetic energy. With the
     // compatible energy update (particle bodies) that is the half step ahead, v^{n+3/2}: the work of
     // every velocity update so far, like the impulse. Otherwise the balance takes the kinetic energy
     // at t^{n+1}, the mean of the half steps around it: a constraint's impulse acts from t^{n+1/2} to
     // t^{n+3/2}, so half of the last update's work is done by then (and none at t = 0). Either way
     // a rigid motion's energy books close to round-off.
-    const bool balance_at_half_step = compatible_energy && !elements;
+    const bool balance_at_half_step = ledger.compatible() && !elements;
     const double region_work_now = regions.report(time, balance_at_half_step, steps == 0 && time == 0.0, totals.regions);
-    totals.boundary_work = boundary_work + element_boundary_work - region_work_now;
+    totals.boundary_work = ledger.boundary_work() + element_boundary_work - region_work_now;
     totals.momentum = all.momentum;
     totals.time = time;
     totals.time_step = dt_half;
@@ -1077,7 +980,7 @@ void Simulation::Impl::sum_totals() {
         // of this half step, so the balance takes their kinetic energy (docs/energy.md); the mean of
         // the two half steps, reported as the kinetic energy at t^n, would add an oscillation of half
         // a step's kinetic-energy change.
-        const double kinetic = compatible_energy && !elements ? all.kinetic : totals.kinetic_energy;
+        const double kinetic = ledger.compatible() && !elements ? all.kinetic : totals.kinetic_energy;
         totals.energy_error = (kinetic + totals.internal_energy + totals.boundary_work - totals.initial_energy) /
                               totals.energy_given;
     }
@@ -1528,7 +1431,6 @@ void Simulation::Impl::write_state(StateWriter& out) const {
     for (int c = 0; c < dim(); ++c) out.array(searched_position[c]);
     out.array(searched_diameter);
     write_plan(out, plan);
-    out.array(bond_power);
     out.array(largest_bond_q);
     out.tag("TIME");
     out.value<double>(time);
@@ -1537,14 +1439,12 @@ void Simulation::Impl::write_state(StateWriter& out) const {
     out.value<std::uint64_t>(steps);
     out.value<double>(node_steps);
     out.value<double>(kinetic_half);
-    out.value<double>(boundary_work);
-    out.value<double>(hourglass_work);
-    out.value<double>(hourglass_energy);
     out.array(body_kinetic_half);
     out.value<std::uint64_t>(totals.bodies.size());
     for (const auto& b : totals.bodies) out.value<double>(b.kinetic_energy);
     out.array(impulse);
     out.array(reaction);
+    ledger.write_state(out);
     regions.write_state(out);
     out.tag("TOTL");
     const Totals& t = totals;
@@ -1601,7 +1501,6 @@ void Simulation::Impl::read_state(StateReader& in) {
     for (int c = 0; c < dim(); ++c) in.array(searched_position[c]);
     in.array(searched_diameter);
     read_plan(in, plan, n);
-    in.array(bond_power);
     in.array(largest_bond_q);
     in.tag("TIME");
     time = in.value<double>();
@@ -1610,9 +1509,6 @@ void Simulation::Impl::read_state(StateReader& in) {
     steps = static_cast<std::size_t>(in.value<std::uint64_t>());
     node_steps = in.value<double>();
     kinetic_half = in.value<double>();
-    boundary_work = in.value<double>();
-    hourglass_work = in.value<double>();
-    hourglass_energy = in.value<double>();
     in.array(body_kinetic_half);
     if (body_kinetic_half.size() != scene.bodies.size()) in.fail("its bodies are not the scene's");
     std::vector<double> body_kinetic(static_cast<std::size_t>(in.value<std::uint64_t>()));
@@ -1621,6 +1517,7 @@ void Simulation::Impl::read_state(StateReader& in) {
     in.array(impulse);
     in.array(reaction);
     if (impulse.size() != rigid_planes.size() || reaction.size() != rigid_planes.size()) in.fail("its planes are not the scene's");
+    ledger.read_state(in);
     regions.read_state(in);
     const std::size_t region_count = scene.prescribed_velocities.size();
     in.tag("TOTL");

@@ -208,7 +208,7 @@ public:
     // Reads the header of a checkpoint (no Simulation needed). Throws CheckpointError.
     static CheckpointInfo checkpoint_info(std::istream& in, std::uint64_t size, const std::string& source);
     // The format version save_checkpoint writes.
-    static constexpr std::uint32_t checkpoint_format = 3;  // 3: with the hourglass stiffness energy
+    static constexpr std::uint32_t checkpoint_format = 4;  // 4: a section per part of the step (energy ledger, regions)
 
 private:
     struct Impl;

@@ -1,0 +1,88 @@
+#pragma once
+// A part of the time step (simulation.cpp): the energy ledger. Every booking of work and heat into
+// the nodes' internal energy happens here, once per step, and the run's sums of work that the energy
+// balance needs (docs/energy.md) are kept here:
+//   * the stress forces' work at the mean velocities of the velocity update, with the compatible
+//     energy update (spec section 5, "[spec] Compatible energy"), and its nodal-viscosity part;
+//   * the bond-viscous forces' work (spec section 5) as heat of their centre;
+//   * the hourglass control's dissipated power as heat of its centre, and the stiffness form's work
+//     as stored internal energy (kernels.hpp);
+//   * the boundary work the penetration guard takes out of the bodies.
+// The force pass writes the powers it finds into the ledger's arrays (bond_power, hourglass_power,
+// stiffness_power); the velocity update then asks for the compatible powers and books the step.
+// Saves and restores its sums as its own checkpoint section.
+
+#include <array>
+#include <cstddef>
+#include <optional>
+#include <vector>
+
+#include "gpa/engine/compressed_rows.hpp"
+#include "gpa/engine/fields.hpp"
+#include "gpa/engine/ghosts.hpp"
+#include "gpa/engine/hourglass.hpp"
+#include "gpa/engine/node_store.hpp"
+#include "gpa/engine/prescribed.hpp"
+#include "gpa/engine/scene.hpp"
+#include "gpa/engine/state_io.hpp"
+#include "gpa/engine/weights.hpp"
+
+namespace gpa {
+
+class EnergyLedger {
+public:
+    explicit EnergyLedger(const SolverOptions& solver);
+
+    bool compatible() const { return compatible_; }
+    bool hourglass() const { return hourglass_; }
+
+    // Per-centre powers of the force pass, W, sized and zeroed for `count` nodes (ghosts included).
+    double* bond_power(std::size_t count);
+    double* hourglass_power(std::size_t count);
+    double* stiffness_power(std::size_t count);  // null without the stiffness form
+
+    // Before the velocity update: v^{n+1/2} of the real nodes, from which the force pass made the
+    // hourglass forces (their power is taken at the mean velocities later). Only when needed.
+    void keep_half_step_velocities(const NodeStore& nodes, std::size_t real);
+
+    // After the velocity update and the prescribed components (compatible update only): the work of
+    // each centre's stress forces and, with the hourglass control, of its control forces at the mean
+    // velocities v_mean = v^{n+3/2} - dt_avg F / (2 M) (held components: the mean of their two half
+    // steps; ghosts mirrored), in one visit of every row (drivers.hpp, compute_stress_power).
+    // `forces` and `control` are the fields of the force pass (control: none without the control;
+    // its velocities and outputs are set here: the kept half-step velocities, the ledger's arrays).
+    template <class G>
+    void compatible_powers(const CompressedRows& lists, WeightKind weight, const ForceFields<G::dim>& forces,
+                           std::optional<HourglassFields<G::dim>> control, double hourglass_coefficient, NodeStore& nodes,
+                           std::size_t real, double dt_avg, const HeldNodes& held,
+                           const std::vector<PrescribedVelocitySpec>& regions, GhostSet& ghosts);
+
+    // Books the step's work and heat into the real nodes (one pass, in a fixed order per node and a
+    // fixed order of the sums, so that nothing depends on the thread count): the compatible stress
+    // work (when computed), bond-viscous heat, hourglass heat and stored hourglass energy.
+    void book(NodeStore& nodes, std::size_t real, double dt_avg);
+
+    void add_boundary_work(double work) { boundary_work_ += work; }
+    double boundary_work() const { return boundary_work_; }
+    double hourglass_work() const { return hourglass_work_; }      // dissipated by the control since t = 0, J
+    double hourglass_energy() const { return hourglass_energy_; }  // stored by the stiffness form since t = 0, J
+
+    void write_state(StateWriter& out) const;
+    void read_state(StateReader& in);
+
+private:
+    bool compatible_ = true;
+    bool bond_ = false;
+    bool hourglass_ = false;
+    bool stiffness_ = false;
+    bool stress_powers_due_ = false;  // compatible_powers ran this step: book the stress work
+    double boundary_work_ = 0.0;
+    double hourglass_work_ = 0.0;
+    double hourglass_energy_ = 0.0;
+    std::vector<double> bond_power_, hourglass_power_, stiffness_power_;  // per node of the force pass
+    std::vector<double> stress_power_, viscous_power_;                   // per real node
+    std::array<std::vector<double>, 3> mean_velocity_;                    // per node, ghosts mirrored
+    std::array<std::vector<double>, 3> half_velocity_;                    // per real node
+};
+
+}  // namespace gpa
