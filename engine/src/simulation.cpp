@@ -31,7 +31,9 @@
 #include "gpa/engine/state_io.hpp"
 #include "gpa/engine/stress.hpp"
 #include "gpa/engine/version.hpp"
+#include "step/contact.hpp"
 #include "step/energy_ledger.hpp"
+#include "step/neighbour_lists.hpp"
 #include "step/regions.hpp"
 
 namespace gpa {
@@ -59,13 +61,6 @@ struct Sums {
     }
 };
 
-PositionView positions_of(const NodeStore& n) {
-    PositionView v;
-    v.dim = n.dim();
-    for (int c = 0; c < n.dim(); ++c) v.component[c] = n.position[c].data();
-    return v;
-}
-
 }  // namespace
 
 struct Simulation::Impl {
@@ -77,66 +72,9 @@ struct Simulation::Impl {
     std::vector<std::size_t> rigid_planes;  // ghost-plane index of each rigid plane of the scene
     std::vector<ConnectivityMode> body_mode;
     std::vector<std::vector<NodeIndex>> material_groups;
-    CompressedRows lists;
-    bool lists_constant = false;  // all fixed, one body, no ghosts: the lists never change
-    NeighbourScratch search_scratch;
-    // Verlet lists (SolverOptions::neighbour_skin): candidates within 2 h_ij + skin from the last
-    // search, the positions and diameters then, and which leading entries of a row are kept
-    // whatever the distance (a fixed centre's lattice neighbours and their mirrors).
-    bool with_skin = false;
-    bool search_due = true;
-    bool plan_due = false;  // lists searched without a skin need a new scatter plan
-    double skin = 0.0;
-    std::size_t searches = 0;
-    CompressedRows candidates;
-    std::vector<std::uint32_t> lattice_entries;  // per row: how many leading candidates are lattice neighbours
-    std::vector<std::uint8_t> keep_scratch;
-    std::array<std::vector<double>, 3> searched_position;
-    std::vector<double> searched_diameter;
-    ScatterPlan plan;
+    NeighbourLists neighbour_lists;  // lists, skin cache, scatter plan (step/neighbour_lists.hpp)
+    Contact contact;                 // separation and sliding state (step/contact.hpp)
     SmoothingScratch smoothing_scratch;
-    // Separable pairs (separation.hpp): between bodies, and through failed nodes when failure is on
-    // and solver.separate_failed; decided every step before the velocity gradient.
-    bool with_separation = false;
-    bool separate_failed = false;
-    bool sliding_contact = false;  // with_separation and solver.sliding_contact
-    // Per node (ghosts mirrored), the outward direction of its body where it touches another
-    // (separation.hpp), for the contact normals of sliding contact; made in neighbours().
-    std::array<std::vector<double>, 3> contact_direction;
-
-    // The pair fields of a phase, with sliding contact where the scene has it (fields.hpp).
-    template <int D>
-    PairFields<D> with_contact(PairFields<D> p) const {
-        p.sliding_contact = sliding_contact;
-        p.failed_pairs_separate = separate_failed;
-        p.failed = nodes.failed.data();
-        if (sliding_contact) {
-            for (int c = 0; c < D; ++c) p.contact_direction[c] = contact_direction[c].data();
-        }
-        return p;
-    }
-
-    // The open separable pairs out of the real rows (separation.hpp), with the closing speeds and
-    // contact directions of the step.
-    void separate_pairs() {
-        std::array<double*, 3> towards{};
-        if (sliding_contact) {
-            for (int c = 0; c < dim(); ++c) {
-                resize_with_slack(contact_direction[c], nodes.size());
-                towards[c] = contact_direction[c].data();
-            }
-        }
-        remove_open_pairs(lists, nodes, real, separate_failed, closing_speed.data(), towards, a());
-    }
-
-    // The ghosts' contact directions, mirrored from their sources once the ghost rows are in.
-    void mirror_contact_direction() {
-        if (!sliding_contact || ghosts.empty()) return;
-        ghosts.mirror_vector_field({contact_direction[0].data(), contact_direction[1].data(),
-                                    dim() == 3 ? contact_direction[2].data() : nullptr},
-                                   dim(), real);
-    }
-    std::vector<double> closing_speed;     // per real node (separation.hpp); empty without separation
     ImpactFrame impact;                    // body_report.hpp, from the initial state
     std::vector<double> body_kinetic_half; // per body, like kinetic_half
     bool any_automatic = false;          // some body switches fixed nodes to variable
@@ -172,6 +110,8 @@ struct Simulation::Impl {
         : scene(std::move(s)),
           threads(thread_count),
           nodes(scene.geometry),
+          neighbour_lists(scene.solver),
+          contact(scene),
           regions(scene.prescribed_velocities),
           ledger(scene.solver) {}
 
@@ -189,15 +129,14 @@ struct Simulation::Impl {
     template <class G>
     void geometry();
     void neighbours();
-    bool candidates_stale(double range) const;
-    void search_candidates();
-    void check_lists_against_search();
     template <class G>
     void gradient();
     template <class G>
     void stress();
     void switching();
     void refresh_ghosts_and_plan();
+    const CompressedRows& lists() const { return neighbour_lists.rows(); }
+    const ScatterPlan& plan() const { return neighbour_lists.plan(); }
     void time_step();
     template <class G>
     void forces();
@@ -298,14 +237,10 @@ void Simulation::Impl::setup() {
     if (particles && scene.solver.reorder_interval > 0) reorder();
     regroup_materials();
     regions.index(nodes, real);
-    separate_failed = scene.solver.failure && scene.solver.separate_failed;
-    with_separation = scene.bodies.size() > 1 || separate_failed;
-    sliding_contact = with_separation && scene.solver.sliding_contact;
-    if (with_separation) closing_speed.assign(real, 0.0);
-    lists_constant = !with_separation && ghosts.empty() && !needs_search(nodes, real) &&
-                     std::none_of(body_mode.begin(), body_mode.end(),
-                                  [](ConnectivityMode m) { return m == ConnectivityMode::Automatic; });
-    with_skin = scene.solver.neighbour_skin > 0.0 && !lists_constant;
+    contact.set_up(real);
+    neighbour_lists.set_up(!contact.separation() && ghosts.empty() && !needs_search(nodes, real) &&
+                           std::none_of(body_mode.begin(), body_mode.end(),
+                                        [](ConnectivityMode m) { return m == ConnectivityMode::Automatic; }));
     any_automatic = std::any_of(body_mode.begin(), body_mode.end(), [](ConnectivityMode m) { return m == ConnectivityMode::Automatic; });
 
     // Geometry, neighbours, geometry factors and forces at t = 0; then the first half step.
@@ -346,8 +281,7 @@ void Simulation::Impl::reorder() {
     nodes.resize(real);  // ghosts are rebuilt after every move
     const double cell = largest_interaction_radius(nodes, a(), real);
     nodes.permute(locality_order(nodes, cell, 0, real));
-    lists.clear();  // rebuilt in the new numbering by the neighbours phase
-    search_due = true;
+    neighbour_lists.invalidate();  // rebuilt in the new numbering by the neighbours phase
     regroup_materials();
     regions.index(nodes, real);
 }
@@ -407,175 +341,21 @@ void Simulation::Impl::geometry() {
         }
         update_size_weights(nodes, r.begin(), r.end());
     });
-    const double range = largest_interaction_radius(nodes, a(), real);
-    if (with_skin && !search_due) search_due = candidates_stale(range);
-    if (!ghosts.empty()) {
-        ghosts.update_contacts(nodes, real, steps == 0 && time == 0.0);
-        if (!with_skin) {
-            ghosts.build(nodes, real, range);
-        } else if (search_due) {
-            // Ghosts for every node within the candidates' reach, kept until the next search.
-            skin = scene.solver.neighbour_skin * range;
-            ghosts.build(nodes, real, range + skin, true);
-        } else {
-            ghosts.update(nodes, real);
-        }
-    }
-}
-
-bool Simulation::Impl::candidates_stale(double range) const {
-    // A pair (i, j) left out by the last search had r >= 2 h_ij + skin then. Now r has shrunk by
-    // at most |u_i - u_j| <= 2 max |u - U| (u the displacements since the search, U any common
-    // translation: the middle of the u), and 2 h_ij has grown by at most 2 a max (d - d_then).
-    // The candidates are stale once those two can add up to the skin. Pairs with ghosts get the
-    // same bound from the ghost set, which must also still hold every node within reach of a plane.
-    struct Extent {
-        std::array<double, 3> lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
-        double growth = 0.0;
-    };
-    const int d = dim();
-    const Extent e = tbb::parallel_reduce(
-        tbb::blocked_range<std::size_t>(0, real, reduce_grain), Extent{},
-        [&](const tbb::blocked_range<std::size_t>& r, Extent acc) {
-            for (std::size_t i = r.begin(); i != r.end(); ++i) {
-                for (int c = 0; c < d; ++c) {
-                    const double u = nodes.position[c][i] - searched_position[c][i];
-                    acc.lo[c] = std::min(acc.lo[c], u);
-                    acc.hi[c] = std::max(acc.hi[c], u);
-                }
-                acc.growth = std::max(acc.growth, nodes.diameter[i] - searched_diameter[i]);
-            }
-            return acc;
-        },
-        [](Extent x, const Extent& y) {
-            for (int c = 0; c < 3; ++c) {
-                x.lo[c] = std::min(x.lo[c], y.lo[c]);
-                x.hi[c] = std::max(x.hi[c], y.hi[c]);
-            }
-            x.growth = std::max(x.growth, y.growth);
-            return x;
-        });
-    std::array<double, 3> middle{0, 0, 0};
-    for (int c = 0; c < d; ++c) middle[c] = 0.5 * (e.lo[c] + e.hi[c]);
-    const double largest = tbb::parallel_reduce(
-        tbb::blocked_range<std::size_t>(0, real, reduce_grain), 0.0,
-        [&](const tbb::blocked_range<std::size_t>& r, double acc) {
-            for (std::size_t i = r.begin(); i != r.end(); ++i) {
-                double u2 = 0.0;
-                for (int c = 0; c < d; ++c) {
-                    const double u = nodes.position[c][i] - searched_position[c][i] - middle[c];
-                    u2 += u * u;
-                }
-                acc = std::max(acc, u2);
-            }
-            return acc;
-        },
-        [](double x, double y) { return std::max(x, y); });
-    double closing = 2.0 * std::sqrt(largest);
-    if (!ghosts.empty()) {
-        if (!ghosts.covers(nodes, real, range)) return true;
-        closing = std::max(closing, ghosts.mirrored_displacement_bound(nodes, real, searched_position));
-    }
-    // NaN positions make the bound NaN: search, and let the phases report them.
-    return !(closing + 2.0 * a() * e.growth < skin);
-}
-
-void Simulation::Impl::check_lists_against_search() {
-    // The pairs a step without a skin would have: fresh ghosts (only the nodes in contact across
-    // lift-off planes) in a copy of the nodes, a full search, the contact rule. A ghost entry is
-    // compared as (source node, planes), since the two ghost sets number their ghosts differently.
-    NodeStore copy = nodes;
-    GhostSet fresh_ghosts = ghosts;
-    CompressedRows fresh;
-    NeighbourScratch scratch;
-    const CompressedRows* mirrored = nullptr;
-    if (!ghosts.empty()) {
-        fresh_ghosts.build(copy, real, largest_interaction_radius(nodes, a(), real));
-        mirrored = &fresh_ghosts.resolved_fixed_mirrors(copy, real);
-    }
-    find_neighbours(copy, a(), real, fresh, scratch, mirrored);
-    if (!ghosts.empty()) fresh_ghosts.remove_pairs_without_contact(fresh, copy, real);
-    const auto key = [&](const GhostSet& set, NodeIndex j) -> std::uint64_t {
-        if (j < real) return j;
-        const std::size_t k = j - real;
-        return (std::uint64_t{set.planes_of(k)} << 40) | set.source(k);
-    };
-    for (std::size_t i = 0; i < real; ++i) {
-        std::vector<std::uint64_t> mine, theirs;
-        for (NodeIndex j : lists.row(i)) mine.push_back(key(ghosts, j));
-        for (NodeIndex j : fresh.row(i)) theirs.push_back(key(fresh_ghosts, j));
-        std::sort(mine.begin(), mine.end());
-        std::sort(theirs.begin(), theirs.end());
-        if (mine != theirs) {
-            throw NumericalError(fmt::format("step {}: node {} has {} neighbours from the candidate lists but {} from a "
-                                             "full search",
-                                             steps, i, mine.size(), theirs.size()));
-        }
-    }
-}
-
-void Simulation::Impl::search_candidates() {
-    const CompressedRows* mirrored = ghosts.empty() ? nullptr : &ghosts.resolved_fixed_mirrors(nodes, real);
-    if (ghosts.empty()) skin = scene.solver.neighbour_skin * largest_interaction_radius(nodes, a(), real);
-    find_neighbours(nodes, a(), real, candidates, search_scratch, mirrored, skin, any_automatic);
-    lattice_entries.assign(real, 0);
-    for (std::size_t i = 0; i < real; ++i) {
-        if (nodes.connectivity[i] != Connectivity::Fixed) continue;
-        lattice_entries[i] = static_cast<std::uint32_t>(nodes.fixed_neighbours.row(i).size() + (mirrored ? mirrored->row(i).size() : 0));
-    }
-    for (int c = 0; c < dim(); ++c) searched_position[c].assign(nodes.position[c].begin(), nodes.position[c].begin() + real);
-    searched_diameter.assign(nodes.diameter.begin(), nodes.diameter.begin() + real);
-    // The scatter plan of the candidates (with their ghost rows) serves every step until the
-    // next search: a plan without conflicts for some lists has none for any subset of them.
-    if (ghosts.empty()) {
-        plan = make_plan(scene.solver.scatter, candidates, positions_of(nodes), nodes.size());
-    } else {
-        // The ghost rows go on the candidates for the plan and come off again (no copy: memory).
-        const std::size_t entries = candidates.entries();
-        ghosts.append_ghost_rows(candidates, real);
-        plan = make_plan(scene.solver.scatter, candidates, positions_of(nodes), nodes.size());
-        candidates.offsets.resize(real + 1);
-        candidates.indices.resize(entries);
-    }
-    search_due = false;
-    ++searches;
+    neighbour_lists.place_ghosts(nodes, real, ghosts, a(), steps == 0 && time == 0.0);
 }
 
 void Simulation::Impl::neighbours() {
-    if (lists_constant && lists.rows() == real) return;
-    if (with_skin) {
-        if (search_due) search_candidates();
-        filter_candidates(nodes, a(), candidates, lattice_entries, lists, keep_scratch);
-        if (!ghosts.empty()) ghosts.remove_pairs_without_contact(lists, nodes, real);
-        if (scene.solver.check_neighbour_lists) check_lists_against_search();
-        if (with_separation) separate_pairs();
-        if (!ghosts.empty()) ghosts.append_ghost_rows(lists, real);
-        mirror_contact_direction();
-        return;
-    }
-    ++searches;
-    plan_due = true;
-    if (ghosts.empty()) {
-        find_neighbours(nodes, a(), real, lists, search_scratch);
-        if (with_separation) separate_pairs();
-        return;
-    }
-    const CompressedRows& mirrored = ghosts.resolved_fixed_mirrors(nodes, real);
-    find_neighbours(nodes, a(), real, lists, search_scratch, &mirrored);
-    ghosts.remove_pairs_without_contact(lists, nodes, real);
-    if (with_separation) separate_pairs();
-    ghosts.append_ghost_rows(lists, real);
-    mirror_contact_direction();
+    neighbour_lists.update(nodes, real, ghosts, a(), any_automatic, contact, steps);
 }
 
 template <class G>
 void Simulation::Impl::gradient() {
     auto f = gradient_fields<G::dim>(nodes, a());
-    f.pairs = with_contact(f.pairs);
+    f.pairs = contact.fields(f.pairs, nodes);
     f.alpha_limit = scene.solver.alpha_limit;
     f.full_normalisation = scene.solver.normalisation == Normalisation::MomentMatrix;
     f.allow_degenerate = true;  // a fragment that has lost its neighbours flies on (see fields.hpp)
-    compute_velocity_gradient<G>(lists, scene.solver.weight, f, real);
+    compute_velocity_gradient<G>(lists(), scene.solver.weight, f, real);
 }
 
 template <class G>
@@ -634,11 +414,7 @@ void Simulation::Impl::switching() {
 
 void Simulation::Impl::refresh_ghosts_and_plan() {
     if (!ghosts.empty()) ghosts.refresh(nodes, real);
-    // With a skin the plan comes with the search (search_candidates); lists that did not change
-    // keep theirs (a plan depends on the lists and on the positions it was made from only).
-    if (!plan_due) return;
-    plan = make_plan(scene.solver.scatter, lists, positions_of(nodes), nodes.size());
-    plan_due = false;
+    neighbour_lists.refresh_plan(nodes);
 }
 
 void Simulation::Impl::time_step() {
@@ -657,6 +433,7 @@ void Simulation::Impl::time_step() {
     // step late gave back more work than its compression had booked: the kinetic energy of the
     // all-variable hypervelocity impact at 0.2 mm quadrupled in 20 steps, energy balance intact,
     // with the internal energy going negative.
+    const double* closing_speed = contact.closing_speed();
     const double volume_limit = scene.solver.max_volume_change > 0.0 ? scene.solver.max_volume_change / scene.solver.cfl : 0.0;
     const double limit = tbb::parallel_reduce(
         tbb::blocked_range<std::size_t>(0, real, reduce_grain), std::numeric_limits<double>::infinity(),
@@ -665,7 +442,7 @@ void Simulation::Impl::time_step() {
                 const double h = nodes.stable_length[i];
                 const double density = nodes.mass[i] / nodes.volume[i];
                 const double q = std::max(nodes.viscous_pressure[i], largest_bond_q.empty() ? 0.0 : largest_bond_q[i]);
-                const double closing = closing_speed.empty() ? 0.0 : closing_speed[i];
+                const double closing = closing_speed ? closing_speed[i] : 0.0;
                 const double speed = nodes.sound_speed[i] + std::sqrt(std::max(q, 0.0) / density) + closing;
                 double local = h / speed;
                 const double rate = nodes.volumetric_strain_rate[i];
@@ -712,7 +489,7 @@ void Simulation::Impl::time_step() {
 template <class G>
 void Simulation::Impl::forces() {
     auto f = force_fields<G::dim>(nodes, a());
-    f.pairs = with_contact(f.pairs);
+    f.pairs = contact.fields(f.pairs, nodes);
     f.hoop_count = real;
     f.full_normalisation = scene.solver.normalisation == Normalisation::MomentMatrix;
     BondViscosityParameters bond{scene.solver.viscosity_linear, scene.solver.viscosity_quadratic, scene.solver.bond_viscosity_eps0};
@@ -723,9 +500,9 @@ void Simulation::Impl::forces() {
         largest_bond_q.assign(nodes.size(), 0.0);
         f.largest_bond_viscosity = largest_bond_q.data();
     }
-    compute_forces<G>(lists, plan, scene.solver.weight, with_bond ? &bond : nullptr, f, nodes.size());
+    compute_forces<G>(lists(), plan(), scene.solver.weight, with_bond ? &bond : nullptr, f, nodes.size());
     if (ledger.hourglass()) {
-        apply_hourglass_control<G::dim>(lists, plan,
+        apply_hourglass_control<G::dim>(lists(), plan(),
                                         hourglass_control_fields<G>(ledger.hourglass_power(nodes.size()), ledger.stiffness_power(nodes.size())),
                                         real, scene.solver.hourglass_coefficient);
     }
@@ -741,7 +518,7 @@ HourglassFields<G::dim> Simulation::Impl::hourglass_control_fields(double* power
     // `stiffness_power`.
     auto h = hourglass_fields<G::dim>(nodes, scene.solver.switch_plastic_strain, power, scene.solver.hourglass_stiffness,
                                       stiffness_power);
-    if (sliding_contact && separate_failed) h.failed = nodes.failed.data();
+    if (contact.sliding() && contact.failed_pairs_separate()) h.failed = nodes.failed.data();
     return h;
 }
 
@@ -770,12 +547,12 @@ void Simulation::Impl::integrate(double dt_avg) {
     for (std::size_t k = 0; k < reaction.size(); ++k) impulse[k] += reaction[k] * dt_avg;
     if (ledger.compatible() && particles) {
         auto f = force_fields<G::dim>(nodes, a());
-        f.pairs = with_contact(f.pairs);
+        f.pairs = contact.fields(f.pairs, nodes);
         f.full_normalisation = scene.solver.normalisation == Normalisation::MomentMatrix;
         if (scene.solver.viscosity != ViscosityKind::Nodal) f.viscous_pressure = nullptr;  // as in forces()
         std::optional<HourglassFields<G::dim>> control;
         if (ledger.hourglass()) control = hourglass_control_fields<G>(nullptr, nullptr);  // the ledger sets the outputs
-        ledger.compatible_powers<G>(lists, scene.solver.weight, f, control, scene.solver.hourglass_coefficient, nodes, real,
+        ledger.compatible_powers<G>(lists(), scene.solver.weight, f, control, scene.solver.hourglass_coefficient, nodes, real,
                                     dt_avg, held, scene.prescribed_velocities, ghosts);
     }
     ledger.book(nodes, real, dt_avg);
@@ -800,7 +577,7 @@ void Simulation::Impl::smoothing() {
     o.held = regions.held_bits();
     std::array<double*, G::dim> v{};
     for (int c = 0; c < G::dim; ++c) v[c] = nodes.velocity[c].data();
-    smooth_velocities<G>(lists, plan, scene.solver.weight, with_contact(pair_fields<G::dim>(nodes, a())), real, o, v,
+    smooth_velocities<G>(lists(), plan(), scene.solver.weight, contact.fields(pair_fields<G::dim>(nodes, a()), nodes), real, o, v,
                          nodes.mass.data(), nodes.pressure.data(), nodes.internal_energy.data(), smoothing_scratch);
     regions.book_smoothing(G::dim, nodes.mass.data(), smoothing_scratch.total_change);
 }
@@ -965,8 +742,8 @@ void Simulation::Impl::sum_totals() {
     totals.ghost_nodes = nodes.size() - real;
     totals.variable_nodes = s.variable;
     totals.failed_nodes = s.failed;
-    totals.pairs = lists.entries();
-    totals.neighbour_searches = searches;
+    totals.pairs = lists().entries();
+    totals.neighbour_searches = neighbour_lists.searches();
     totals.planes.clear();
     for (std::size_t k = 0; k < rigid_planes.size(); ++k) {
         const double element_reaction = elements ? elements->reactions()[k] : 0.0;
@@ -1080,7 +857,7 @@ Simulation::Simulation(Scene scene, int threads, MemoryLimit memory)
     validate_scene(impl_->scene);
     check_scene_memory(impl_->scene, memory);
     impl_->memory_limit = std::move(memory);
-    impl_->search_scratch.check_entries = [im = impl_.get()](std::size_t entries) {
+    impl_->neighbour_lists.set_entry_check([im = impl_.get()](std::size_t entries) {
         const int dim = im->dim();
         const double bytes = double(im->nodes.size()) * bytes_per_node_besides_lists(dim) +
                              double(entries) * bytes_per_list_entry;
@@ -1090,7 +867,7 @@ Simulation::Simulation(Scene scene, int threads, MemoryLimit memory)
                                          entries, double(entries) / double(std::max<std::size_t>(im->real, 1)),
                                          format_bytes(bytes), describe_limit(im->memory_limit)));
         }
-    };
+    });
     impl_->threads.run([this] {
         dispatch_geometry(impl_->scene.geometry, [this](auto g) { impl_->setup<decltype(g)>(); });
     });
@@ -1148,7 +925,7 @@ const Totals& Simulation::totals() const { return impl_->totals; }
 void Simulation::measure_bodies() {
     impl_->measure_local_fields();
     if (!impl_->particles) return;
-    gpa::measure_bodies(impl_->nodes, impl_->real, impl_->lists, impl_->impact, impl_->totals.bodies);
+    gpa::measure_bodies(impl_->nodes, impl_->real, impl_->lists(), impl_->impact, impl_->totals.bodies);
 }
 
 void Simulation::Impl::measure_local_fields() {
@@ -1231,7 +1008,7 @@ std::vector<std::string> Simulation::phases() const { return impl_->graph->names
 double Simulation::node_steps() const { return impl_->node_steps; }
 double Simulation::element_steps() const { return impl_->element_steps; }
 const ElementPart* Simulation::elements() const { return impl_->elements.get(); }
-const CompressedRows& Simulation::neighbour_lists() const { return impl_->lists; }
+const CompressedRows& Simulation::neighbour_lists() const { return impl_->lists(); }
 
 // --- limits, failure reports and checkpoints ----------------------------------------------
 
@@ -1372,27 +1149,6 @@ namespace {
 constexpr char checkpoint_magic[8] = {'G', 'P', 'A', 'C', 'H', 'K', 'P', 'T'};
 constexpr std::uint32_t byte_order_mark = 0x01020304u;
 
-void write_plan(StateWriter& out, const ScatterPlan& plan) {
-    out.value<std::int32_t>(static_cast<std::int32_t>(plan.scheme));
-    out.array(plan.colour_offsets);
-    out.array(plan.group_offsets);
-    out.array(plan.centres);
-}
-
-void read_plan(StateReader& in, ScatterPlan& plan, std::size_t node_count) {
-    plan.scheme = static_cast<ScatterScheme>(in.value<std::int32_t>());
-    in.array(plan.colour_offsets);
-    in.array(plan.group_offsets);
-    in.array(plan.centres);
-    const bool fits = !plan.colour_offsets.empty() && !plan.group_offsets.empty() &&
-                      plan.colour_offsets.back() <= plan.group_offsets.size() - 1 &&
-                      plan.group_offsets.back() <= plan.centres.size();
-    if (!fits) in.fail("its scatter plan is damaged");
-    for (const NodeIndex c : plan.centres) {
-        if (c >= node_count) in.fail("its scatter plan names a node that does not exist");
-    }
-}
-
 // The header: everything up to the state, read again by checkpoint_info.
 CheckpointInfo read_header(StateReader& in) {
     char magic[8];
@@ -1420,19 +1176,9 @@ void Simulation::Impl::write_state(StateWriter& out) const {
     nodes.write_state(out);
     out.value<std::uint64_t>(real);
     ghosts.write_state(out);
-    out.tag("LIST");
-    write_rows(out, lists);
-    out.value<std::uint8_t>(search_due);
-    out.value<std::uint8_t>(plan_due);
-    out.value<double>(skin);
-    out.value<std::uint64_t>(searches);
-    write_rows(out, candidates);
-    out.array(lattice_entries);
-    for (int c = 0; c < dim(); ++c) out.array(searched_position[c]);
-    out.array(searched_diameter);
-    write_plan(out, plan);
-    out.array(largest_bond_q);
+    neighbour_lists.write_state(out, dim());
     out.tag("TIME");
+    out.array(largest_bond_q);
     out.value<double>(time);
     out.value<double>(dt_half);
     out.value<double>(dt_next);
@@ -1490,19 +1236,9 @@ void Simulation::Impl::read_state(StateReader& in) {
     const std::size_t n = nodes.size();
     if (n < real) in.fail("it holds fewer nodes than the scene's bodies (a damaged checkpoint)");
     ghosts.read_state(in, real, n);
-    in.tag("LIST");
-    read_rows(in, lists, std::numeric_limits<std::size_t>::max(), n);
-    search_due = in.value<std::uint8_t>() != 0;
-    plan_due = in.value<std::uint8_t>() != 0;
-    skin = in.value<double>();
-    searches = static_cast<std::size_t>(in.value<std::uint64_t>());
-    read_rows(in, candidates, std::numeric_limits<std::size_t>::max(), n);
-    in.array(lattice_entries);
-    for (int c = 0; c < dim(); ++c) in.array(searched_position[c]);
-    in.array(searched_diameter);
-    read_plan(in, plan, n);
-    in.array(largest_bond_q);
+    neighbour_lists.read_state(in, dim(), n);
     in.tag("TIME");
+    in.array(largest_bond_q);
     time = in.value<double>();
     dt_half = in.value<double>();
     dt_next = in.value<double>();

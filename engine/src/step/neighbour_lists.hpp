@@ -1,0 +1,92 @@
+#pragma once
+// A part of the time step (simulation.cpp): the neighbour lists and their scatter plan. Owns the
+// rows every pair pass reads (real rows, then the ghost rows), the Verlet candidates of
+// SolverOptions::neighbour_skin (every pair within 2 h_ij + skin at the last search, the positions
+// and diameters then, and how many leading entries of a fixed centre's row are lattice neighbours),
+// and the conflict-free scatter plan of the force passes (colouring.hpp). Places the ghosts each
+// step (their reach follows the skin) and decides when a search is due. Saves and restores its
+// state as its own checkpoint section.
+//
+// The lists of a step are the same with or without a skin, as sets; only the order of a row's
+// entries may differ (check_neighbour_lists compares them with a full search every step).
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "gpa/engine/colouring.hpp"
+#include "gpa/engine/compressed_rows.hpp"
+#include "gpa/engine/ghosts.hpp"
+#include "gpa/engine/neighbours.hpp"
+#include "gpa/engine/node_store.hpp"
+#include "gpa/engine/scene.hpp"
+#include "gpa/engine/state_io.hpp"
+
+namespace gpa {
+
+class Contact;
+
+class NeighbourLists {
+public:
+    explicit NeighbourLists(const SolverOptions& solver) : solver_(&solver) {}
+
+    // Set-up: `constant` when the lists can never change (every node fixed, one body, no ghosts):
+    // then one search serves the whole run and there is no skin.
+    void set_up(bool constant);
+    // Called with the entry count before every search allocates its lists (memory limits).
+    void set_entry_check(std::function<void(std::size_t)> check) { scratch_.check_entries = std::move(check); }
+
+    const CompressedRows& rows() const { return lists_; }
+    const ScatterPlan& plan() const { return plan_; }
+    std::size_t searches() const { return searches_; }
+
+    // The nodes were renumbered (NodeStore::permute): search again in the new numbering.
+    void invalidate();
+
+    // Geometry phase, after the diameters: decides whether the candidates are stale, then places
+    // the ghosts of `ghosts` (all within reach of a plane, with the skin when a search is due;
+    // `first` on the set-up's call, when contacts start from the initial state).
+    void place_ghosts(NodeStore& nodes, std::size_t real, GhostSet& ghosts, double influence_distance, bool first);
+
+    // Neighbours phase: the lists of this step, from the candidates (searched again when due) or
+    // from a full search; pairs across planes without contact out, open separable pairs out
+    // (contact), ghost rows appended. `any_automatic`: the search keeps fixed centres' candidates
+    // too. `step` names the step in the error of check_neighbour_lists.
+    void update(NodeStore& nodes, std::size_t real, GhostSet& ghosts, double influence_distance, bool any_automatic,
+                Contact& contact, std::size_t step);
+
+    // Plan phase: a plan for lists searched without a skin (with a skin the search made one that
+    // serves every step until the next search; lists that did not change keep theirs).
+    void refresh_plan(const NodeStore& nodes);
+
+    void write_state(StateWriter& out, int dim) const;
+    void read_state(StateReader& in, int dim, std::size_t node_count);
+
+private:
+    bool candidates_stale(const NodeStore& nodes, std::size_t real, const GhostSet& ghosts, double influence_distance,
+                          double range) const;
+    void search_candidates(NodeStore& nodes, std::size_t real, GhostSet& ghosts, double influence_distance,
+                           bool any_automatic);
+    void check_against_search(const NodeStore& nodes, std::size_t real, const GhostSet& ghosts, double influence_distance,
+                              std::size_t step) const;
+
+    const SolverOptions* solver_;
+    CompressedRows lists_;
+    bool constant_ = false;
+    bool with_skin_ = false;
+    bool search_due_ = true;
+    bool plan_due_ = false;  // lists searched without a skin need a new scatter plan
+    double skin_ = 0.0;
+    std::size_t searches_ = 0;
+    NeighbourScratch scratch_;
+    CompressedRows candidates_;
+    std::vector<std::uint32_t> lattice_entries_;  // per row: how many leading candidates are lattice neighbours
+    std::vector<std::uint8_t> keep_scratch_;
+    std::array<std::vector<double>, 3> searched_position_;
+    std::vector<double> searched_diameter_;
+    ScatterPlan plan_;
+};
+
+}  // namespace gpa
