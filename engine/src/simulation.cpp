@@ -35,6 +35,7 @@
 #include "step/energy_ledger.hpp"
 #include "step/neighbour_lists.hpp"
 #include "step/regions.hpp"
+#include "step/switching.hpp"
 
 namespace gpa {
 
@@ -70,15 +71,13 @@ struct Simulation::Impl {
     std::size_t real = 0;
     GhostSet ghosts;
     std::vector<std::size_t> rigid_planes;  // ghost-plane index of each rigid plane of the scene
-    std::vector<ConnectivityMode> body_mode;
     std::vector<std::vector<NodeIndex>> material_groups;
     NeighbourLists neighbour_lists;  // lists, skin cache, scatter plan (step/neighbour_lists.hpp)
     Contact contact;                 // separation and sliding state (step/contact.hpp)
+    Switching switching_part;        // connectivity modes and the switching phase (step/switching.hpp)
     SmoothingScratch smoothing_scratch;
     ImpactFrame impact;                    // body_report.hpp, from the initial state
     std::vector<double> body_kinetic_half; // per body, like kinetic_half
-    bool any_automatic = false;          // some body switches fixed nodes to variable
-    std::vector<double> cell_ratio;      // per node, its smallest lattice-cell volume ratio (lattice_check.hpp)
     std::vector<double> largest_bond_q;  // per centre, the largest Q_ij of its pairs (for the time step)
     bool failed = false;                 // a phase threw: the state is half-updated
     std::unique_ptr<PhaseGraph> graph;
@@ -112,6 +111,7 @@ struct Simulation::Impl {
           nodes(scene.geometry),
           neighbour_lists(scene.solver),
           contact(scene),
+          switching_part(scene),
           regions(scene.prescribed_velocities),
           ledger(scene.solver) {}
 
@@ -173,7 +173,6 @@ void Simulation::Impl::setup() {
     const auto mirrors = ghosts.mirror_planes();
     for (std::size_t b = 0; b < scene.bodies.size(); ++b) {
         if (scene.bodies[b].discretisation == Discretisation::Particles) add_body_nodes(nodes, scene, b, mirrors);
-        body_mode.push_back(scene.bodies[b].connectivity.value_or(scene.solver.connectivity));
     }
     real = nodes.size();
     particles = real > 0;
@@ -183,49 +182,7 @@ void Simulation::Impl::setup() {
     }
     validate_nodes(nodes, 0, real);
     regions.assign(scene, nodes, real, elements ? &elements->mesh().nodes : nullptr);
-    // Nodes of variable-connectivity bodies never read their lattice lists: drop them (memory).
-    const auto drop_variable_rows = [&](CompressedRows& rows, std::vector<std::uint8_t>* tags) {
-        CompressedRows kept;
-        std::vector<std::uint8_t> kept_tags;
-        kept.offsets.assign(1, 0);
-        for (std::size_t i = 0; i < real; ++i) {
-            if (body_mode[static_cast<std::size_t>(nodes.body[i])] != ConnectivityMode::Variable) {
-                for (std::size_t e = rows.offsets[i]; e < rows.offsets[i + 1]; ++e) {
-                    kept.indices.push_back(rows.indices[e]);
-                    if (tags) kept_tags.push_back((*tags)[e]);
-                }
-            }
-            kept.offsets.push_back(kept.indices.size());
-        }
-        rows = std::move(kept);
-        if (tags) *tags = std::move(kept_tags);
-    };
-    drop_variable_rows(nodes.fixed_neighbours, nullptr);
-    drop_variable_rows(nodes.fixed_mirrors, &nodes.fixed_mirror_planes);
-    // A fixed-connectivity node meets a plane only through the mirror images of its lattice
-    // neighbours, which exist when the body starts on the plane; a fixed or automatic body that
-    // starts apart from a plane would pass through it.
-    for (std::size_t b = 0; b < scene.bodies.size(); ++b) {
-        if (body_mode[b] == ConnectivityMode::Variable || scene.bodies[b].discretisation != Discretisation::Particles) continue;
-        for (std::size_t k = 0; k < scene.planes.size(); ++k) {
-            const std::size_t bit = planes.size() - scene.planes.size() + k;
-            bool touches = false;
-            for (std::size_t i = 0; i < real && !touches; ++i) {
-                if (nodes.body[i] != static_cast<std::int32_t>(b)) continue;
-                for (std::size_t e = nodes.fixed_mirrors.offsets[i]; e < nodes.fixed_mirrors.offsets[i + 1]; ++e) {
-                    touches |= (nodes.fixed_mirror_planes[e] >> bit) & 1u;
-                }
-            }
-            if (!touches) {
-                throw InputError(fmt::format(
-                    "body \"{}\" uses {} connectivity but does not start on plane \"{}\": fixed nodes meet a plane "
-                    "only through the mirror images of their lattice neighbours; start the body on the plane (its "
-                    "lattice then continues across it) or give it variable connectivity",
-                    scene.bodies[b].name, body_mode[b] == ConnectivityMode::Fixed ? "fixed" : "automatic",
-                    scene.planes[k].name));
-            }
-        }
-    }
+    switching_part.prepare_lattices(scene, nodes, real, planes.size() - scene.planes.size());
     for (const auto& m : scene.materials) materials::validate(m);
     initialise_material_state(nodes, real, scene.materials);
     {
@@ -239,9 +196,7 @@ void Simulation::Impl::setup() {
     regions.index(nodes, real);
     contact.set_up(real);
     neighbour_lists.set_up(!contact.separation() && ghosts.empty() && !needs_search(nodes, real) &&
-                           std::none_of(body_mode.begin(), body_mode.end(),
-                                        [](ConnectivityMode m) { return m == ConnectivityMode::Automatic; }));
-    any_automatic = std::any_of(body_mode.begin(), body_mode.end(), [](ConnectivityMode m) { return m == ConnectivityMode::Automatic; });
+                           !switching_part.any_automatic());
 
     // Geometry, neighbours, geometry factors and forces at t = 0; then the first half step.
     if (particles) {
@@ -345,7 +300,7 @@ void Simulation::Impl::geometry() {
 }
 
 void Simulation::Impl::neighbours() {
-    neighbour_lists.update(nodes, real, ghosts, a(), any_automatic, contact, steps);
+    neighbour_lists.update(nodes, real, ghosts, a(), switching_part.any_automatic(), contact, steps);
 }
 
 template <class G>
@@ -370,46 +325,9 @@ void Simulation::Impl::stress() {
 }
 
 void Simulation::Impl::switching() {
-    // Lattice cells first (spec section 2, "[spec] Lattice cells"): a fixed node whose cell has
-    // collapsed or inverted cannot go on with its lattice stencil. In a fixed body the run stops
-    // there; in an automatic body the node switches at once. Then paper section 6: a fixed node of
-    // an automatic body switches to variable connectivity, for the rest of the run, once its
-    // equivalent plastic strain exceeds the threshold. Decisions read the state before any switch.
-    smallest_lattice_cell_ratios(nodes, real, cell_ratio);
-    const double threshold = scene.solver.switch_plastic_strain;
-    totals.collapse_switches = 0;
-    totals.first_collapse_switch.clear();
-    const auto where = [&](std::size_t i) {
-        const auto& body = scene.bodies[static_cast<std::size_t>(nodes.body[i])];
-        std::string at = fmt::format("body \"{}\", node {} at ", body.name, i);
-        if (dim() == 2) return at + fmt::format("(x, z) = ({:.4g}, {:.4g}) mm", nodes.position[0][i] * 1e3, nodes.position[1][i] * 1e3);
-        return at + fmt::format("(x, y, z) = ({:.4g}, {:.4g}, {:.4g}) mm", nodes.position[0][i] * 1e3, nodes.position[1][i] * 1e3,
-                                nodes.position[2][i] * 1e3);
-    };
-    for (std::size_t i = 0; i < real; ++i) {
-        if (nodes.connectivity[i] != Connectivity::Fixed) continue;
-        const bool collapsed = !(cell_ratio[i] > collapsed_cell_ratio);
-        if (body_mode[static_cast<std::size_t>(nodes.body[i])] == ConnectivityMode::Fixed) {
-            if (!collapsed) continue;
-            // The step's report adds the step, time, phase, body and position (Simulation::step).
-            throw NumericalError(
-                fmt::format("a lattice cell of this fixed-connectivity node has {} (volume ratio {:.3g}); a fixed lattice "
-                            "cannot follow this deformation. Give the body connectivity = \"automatic\" (nodes switch to "
-                            "variable connectivity as they deform) or \"variable\"; a finer spacing helps only where the "
-                            "lattice tangles at a sharp gradient, not under large flow",
-                            cell_ratio[i] <= 0.0 ? "inverted" : "collapsed", cell_ratio[i]),
-                i, "lattice cell volume ratio");
-        }
-        if (!collapsed && !(nodes.plastic_strain[i] > threshold)) continue;
-        // The candidate lists hold every node within reach of a fixed centre too, so they stay
-        // valid: the next cut applies the variable rule to the switched node's pairs.
-        nodes.connectivity[i] = Connectivity::Variable;
-        if (collapsed && !(nodes.plastic_strain[i] > threshold)) {
-            if (totals.collapse_switches++ == 0) {
-                totals.first_collapse_switch = fmt::format("{} (cell volume ratio {:.3g})", where(i), cell_ratio[i]);
-            }
-        }
-    }
+    const Switching::Report report = switching_part.switch_nodes(scene, nodes, real);
+    totals.collapse_switches = report.collapse_switches;
+    totals.first_collapse_switch = report.first_collapse_switch;
 }
 
 void Simulation::Impl::refresh_ghosts_and_plan() {
@@ -834,8 +752,7 @@ void Simulation::Impl::build_phase_graph() {
     // Switching last: a node that switches takes its new rule from the next geometry on, so that
     // its strain rates and forces always use one rule (spec section 2).
     // (Fixed bodies need it too: it checks their lattice cells.)
-    if (particles &&
-        std::any_of(body_mode.begin(), body_mode.end(), [](ConnectivityMode m) { return m != ConnectivityMode::Variable; })) {
+    if (particles && switching_part.any_lattice()) {
         graph->add("switching", [this] { switching(); });
     }
     graph->add("totals", [this] {
