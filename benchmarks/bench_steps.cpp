@@ -275,6 +275,17 @@ int main(int argc, char** argv) {
                                after_setup / static_cast<double>(sim.real_count()),
                                peak_memory_bytes() / static_cast<double>(sim.real_count()),
                                resident_memory_bytes() / static_cast<double>(sim.real_count()));
+                    // What the arrays hold now, by array, largest first (Simulation::memory_use).
+                    auto use = sim.memory_use();
+                    std::sort(use.begin(), use.end(), [](const auto& a, const auto& b) { return a.bytes > b.bytes; });
+                    double total = 0.0;
+                    for (const auto& row : use) total += static_cast<double>(row.bytes);
+                    const double per = 1.0 / static_cast<double>(sim.real_count());
+                    fmt::print("memory {} by array (B/node): ", name);
+                    for (const auto& row : use) {
+                        if (row.bytes > 0) fmt::print("{} {:.1f}; ", row.array, static_cast<double>(row.bytes) * per);
+                    }
+                    fmt::print("total {:.0f}\n", total * per);
                     const fs::path dir = fs::temp_directory_path() / fmt::format("gpa_bench_steps_{}", ::getpid());
                     fs::create_directories(dir);
                     gpa::io::SnapshotSeries series(dir);

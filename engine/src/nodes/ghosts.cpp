@@ -431,4 +431,13 @@ void GhostSet::read_state(StateReader& in, std::size_t real_count, std::size_t n
     }
 }
 
+void GhostSet::memory_use(MemoryUse& out) const {
+    std::size_t index = 0;
+    for (const auto& slot : index_) index += allocated_bytes(slot);
+    add_memory(out, "ghosts: index per plane combination", index);
+    add_memory(out, "ghosts: sources", allocated_bytes(source_) + allocated_bytes(mask_) + allocated_bytes(slot_) +
+                                           allocated_bytes(sources_sorted_));
+    add_memory(out, "ghosts: resolved lattice mirrors", allocated_bytes(resolved_.indices) + allocated_bytes(resolved_.offsets));
+}
+
 }  // namespace gpa

@@ -3,6 +3,8 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <string>
+#include <string_view>
 
 #include <fmt/format.h>
 
@@ -30,40 +32,40 @@ template <class F>
 void NodeStore::for_each_field(F&& f) {
     const int d = dim_;
     for (int c = 0; c < d; ++c) {
-        f(position[c]);
-        f(initial_position[c]);
-        f(velocity[c]);
-        f(alpha[c]);
-        f(force[c]);
+        f("position", position[c]);
+        f("initial_position", initial_position[c]);
+        f("velocity", velocity[c]);
+        f("alpha", alpha[c]);
+        f("force", force[c]);
     }
-    for (int c = 0; c < d * d; ++c) f(velocity_gradient[c]);
-    for (int c = 0; c < (d == 3 ? 3 : 1); ++c) f(alpha_shear[c]);
-    for (int c = 0; c < stress_components(d); ++c) f(deviatoric_stress[c]);
-    f(mass);
-    f(volume);
-    f(initial_volume);
-    f(size_weight);
-    f(diameter);
-    f(initial_diameter);
-    f(volumetric_strain);
-    f(pressure);
-    f(viscous_pressure);
-    f(sound_speed);
-    f(internal_energy);
-    f(temperature);
-    f(plastic_strain);
-    f(damage);
-    f(plastic_work);
-    f(viscous_work);
-    f(failed);
-    f(plane_contact);
-    f(velocity_region);
-    f(stable_length);
-    f(body);
-    f(material);
-    f(connectivity);
-    f(volumetric_strain_rate);
-    f(smallest_h);
+    for (int c = 0; c < d * d; ++c) f("velocity_gradient", velocity_gradient[c]);
+    for (int c = 0; c < (d == 3 ? 3 : 1); ++c) f("alpha_shear", alpha_shear[c]);
+    for (int c = 0; c < stress_components(d); ++c) f("deviatoric_stress", deviatoric_stress[c]);
+    f("mass", mass);
+    f("volume", volume);
+    f("initial_volume", initial_volume);
+    f("size_weight", size_weight);
+    f("diameter", diameter);
+    f("initial_diameter", initial_diameter);
+    f("volumetric_strain", volumetric_strain);
+    f("pressure", pressure);
+    f("viscous_pressure", viscous_pressure);
+    f("sound_speed", sound_speed);
+    f("internal_energy", internal_energy);
+    f("temperature", temperature);
+    f("plastic_strain", plastic_strain);
+    f("damage", damage);
+    f("plastic_work", plastic_work);
+    f("viscous_work", viscous_work);
+    f("failed", failed);
+    f("plane_contact", plane_contact);
+    f("velocity_region", velocity_region);
+    f("stable_length", stable_length);
+    f("body", body);
+    f("material", material);
+    f("connectivity", connectivity);
+    f("volumetric_strain_rate", volumetric_strain_rate);
+    f("smallest_h", smallest_h);
 }
 
 namespace {
@@ -118,7 +120,7 @@ void NodeStore::resize(std::size_t count) {
     // Growing past the capacity reserves 1/8 more than asked, not the doubling that resize()
     // itself would do: the ghosts come and go every step, and doubled fields would double the
     // memory of a run.
-    for_each_field([count](auto& field) { resize_with_slack(field, count); });
+    for_each_field([count](std::string_view, auto& field) { resize_with_slack(field, count); });
     resize_rows(fixed_neighbours, nullptr, count);
     resize_rows(fixed_mirrors, &fixed_mirror_planes, count);
 }
@@ -138,7 +140,7 @@ void NodeStore::permute(std::span<const NodeIndex> new_to_old) {
         }
         old_to_new[old] = static_cast<NodeIndex>(k);
     }
-    for_each_field([&](auto& field) {
+    for_each_field([&](std::string_view, auto& field) {
         auto copy = field;
         for (std::size_t k = 0; k < n; ++k) field[k] = copy[new_to_old[k]];
     });
@@ -231,7 +233,7 @@ void NodeStore::write_state(StateWriter& out) const {
     out.value<std::int32_t>(static_cast<std::int32_t>(geometry_));
     out.value<std::uint64_t>(size());
     // for_each_field only reads here.
-    const_cast<NodeStore*>(this)->for_each_field([&](auto& field) { out.array(field); });
+    const_cast<NodeStore*>(this)->for_each_field([&](std::string_view, auto& field) { out.array(field); });
     write_rows(out, fixed_neighbours);
     write_rows(out, fixed_mirrors);
     out.array(fixed_mirror_planes);
@@ -242,7 +244,7 @@ void NodeStore::read_state(StateReader& in) {
     if (in.value<std::int32_t>() != static_cast<std::int32_t>(geometry_)) in.fail("its nodes are of another geometry");
     const auto count = in.value<std::uint64_t>();
     if (count > 0xFFFFFFFFu) in.fail("its node count is out of range (a damaged checkpoint)");
-    for_each_field([&](auto& field) {
+    for_each_field([&](std::string_view, auto& field) {
         in.array(field);
         if (field.size() != count) in.fail("a node field has the wrong length (a damaged checkpoint)");
     });
@@ -250,6 +252,19 @@ void NodeStore::read_state(StateReader& in) {
     read_rows(in, fixed_mirrors, count, count);
     in.array(fixed_mirror_planes);
     if (fixed_mirror_planes.size() != fixed_mirrors.entries()) in.fail("the mirrored lattice lists are damaged");
+}
+
+}  // namespace gpa
+
+namespace gpa {
+
+void NodeStore::memory_use(MemoryUse& out) const {
+    // for_each_field only reads here.
+    const_cast<NodeStore*>(this)->for_each_field(
+        [&](std::string_view name, auto& field) { add_memory(out, "nodes: " + std::string(name), allocated_bytes(field)); });
+    add_memory(out, "nodes: fixed neighbours", allocated_bytes(fixed_neighbours.indices) + allocated_bytes(fixed_neighbours.offsets));
+    add_memory(out, "nodes: fixed mirrors",
+               allocated_bytes(fixed_mirrors.indices) + allocated_bytes(fixed_mirrors.offsets) + allocated_bytes(fixed_mirror_planes));
 }
 
 }  // namespace gpa

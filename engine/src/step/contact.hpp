@@ -13,6 +13,7 @@
 #include "gpa/engine/compressed_rows.hpp"
 #include "gpa/engine/fields.hpp"
 #include "gpa/engine/ghosts.hpp"
+#include "gpa/engine/memory_use.hpp"
 #include "gpa/engine/node_store.hpp"
 #include "gpa/engine/scene.hpp"
 
@@ -56,6 +57,12 @@ public:
     // Per real node, the largest speed at which a closed separable pair closes on it (the time
     // step, spec section 11); null without separation.
     const double* closing_speed() const { return closing_speed_.empty() ? nullptr : closing_speed_.data(); }
+
+    void memory_use(MemoryUse& out) const {
+        std::size_t directions = 0;
+        for (const auto& d : direction_) directions += allocated_bytes(d);
+        add_memory(out, "contact: closing speeds and directions", allocated_bytes(closing_speed_) + directions);
+    }
 
 private:
     bool failed_pairs_separate_;

@@ -131,6 +131,16 @@ void EnergyLedger::book(NodeStore& nodes, std::size_t real, double dt_avg) {
     if (stiffness_) hourglass_energy_ += sums[1];
 }
 
+void EnergyLedger::memory_use(MemoryUse& out) const {
+    add_memory(out, "energy ledger: powers per node", allocated_bytes(bond_power_) + allocated_bytes(hourglass_power_) +
+                                                          allocated_bytes(stiffness_power_) + allocated_bytes(stress_power_) +
+                                                          allocated_bytes(viscous_power_));
+    std::size_t velocities = 0;
+    for (const auto& v : mean_velocity_) velocities += allocated_bytes(v);
+    for (const auto& v : half_velocity_) velocities += allocated_bytes(v);
+    add_memory(out, "energy ledger: mean and half-step velocities", velocities);
+}
+
 void EnergyLedger::write_state(StateWriter& out) const {
     out.tag("ENRG");
     out.value<double>(boundary_work_);

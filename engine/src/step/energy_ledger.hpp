@@ -67,6 +67,8 @@ public:
     double hourglass_work() const { return hourglass_work_; }      // dissipated by the control since t = 0, J
     double hourglass_energy() const { return hourglass_energy_; }  // stored by the stiffness form since t = 0, J
 
+    void memory_use(MemoryUse& out) const;
+
     void write_state(StateWriter& out) const;
     void read_state(StateReader& in);
 

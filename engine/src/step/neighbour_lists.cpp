@@ -258,4 +258,16 @@ void NeighbourLists::read_state(StateReader& in, int dim, std::size_t node_count
     read_plan(in, plan_, node_count);
 }
 
+void NeighbourLists::memory_use(MemoryUse& out) const {
+    add_memory(out, "neighbour lists: lists", allocated_bytes(lists_.indices) + allocated_bytes(lists_.offsets));
+    add_memory(out, "neighbour lists: skin candidates", allocated_bytes(candidates_.indices) + allocated_bytes(candidates_.offsets) +
+                                                            allocated_bytes(lattice_entries_) + allocated_bytes(keep_scratch_));
+    std::size_t searched = allocated_bytes(searched_diameter_);
+    for (const auto& p : searched_position_) searched += allocated_bytes(p);
+    add_memory(out, "neighbour lists: positions at the last search", searched);
+    add_memory(out, "neighbour lists: scatter plan",
+               allocated_bytes(plan_.centres) + allocated_bytes(plan_.group_offsets) + allocated_bytes(plan_.colour_offsets));
+    add_memory(out, "neighbour lists: cell grid", allocated_bytes(scratch_.grid.nodes) + allocated_bytes(scratch_.grid.cell_start));
+}
+
 }  // namespace gpa

@@ -61,6 +61,8 @@ public:
     // serves every step until the next search; lists that did not change keep theirs).
     void refresh_plan(const NodeStore& nodes);
 
+    void memory_use(MemoryUse& out) const;
+
     void write_state(StateWriter& out, int dim) const;
     void read_state(StateReader& in, int dim, std::size_t node_count);
 

@@ -927,6 +927,24 @@ double Simulation::element_steps() const { return impl_->element_steps; }
 const ElementPart* Simulation::elements() const { return impl_->elements.get(); }
 const CompressedRows& Simulation::neighbour_lists() const { return impl_->lists(); }
 
+MemoryUse Simulation::memory_use() const {
+    const Impl& im = *impl_;
+    MemoryUse out;
+    im.nodes.memory_use(out);
+    im.neighbour_lists.memory_use(out);
+    im.ghosts.memory_use(out);
+    im.contact.memory_use(out);
+    im.ledger.memory_use(out);
+    im.switching_part.memory_use(out);
+    add_memory(out, "forces: largest bond viscosity", allocated_bytes(im.largest_bond_q));
+    const auto& s = im.smoothing_scratch;
+    add_memory(out, "smoothing: scratch", allocated_bytes(s.centre_change) + allocated_bytes(s.share) + allocated_bytes(s.total_change));
+    std::size_t groups = 0;
+    for (const auto& g : im.material_groups) groups += allocated_bytes(g);
+    add_memory(out, "stress: material groups", groups);
+    return out;
+}
+
 // --- limits, failure reports and checkpoints ----------------------------------------------
 
 namespace {

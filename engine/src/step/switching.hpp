@@ -41,6 +41,8 @@ public:
     };
     Report switch_nodes(const Scene& scene, NodeStore& nodes, std::size_t real);
 
+    void memory_use(MemoryUse& out) const { add_memory(out, "switching: lattice cell ratios", allocated_bytes(cell_ratio_)); }
+
 private:
     std::vector<ConnectivityMode> body_mode_;
     bool any_automatic_ = false;

@@ -114,6 +114,9 @@ public:
     void write_state(StateWriter& out) const;
     void read_state(StateReader& in, std::size_t real_count, std::size_t node_count);
 
+    // The bytes its arrays take (memory_use.hpp), as "ghosts: ARRAY".
+    void memory_use(MemoryUse& out) const;
+
 private:
     std::vector<GhostPlane> planes_;
     std::vector<std::uint8_t> masks_;            // the corner combinations in use: distinct axes

@@ -13,6 +13,7 @@
 
 #include "gpa/engine/compressed_rows.hpp"
 #include "gpa/engine/geometry.hpp"
+#include "gpa/engine/memory_use.hpp"
 
 namespace gpa {
 
@@ -41,6 +42,9 @@ public:
     // read_state throws CheckpointError when the data is not that of a store of this geometry.
     void write_state(StateWriter& out) const;
     void read_state(StateReader& in);
+
+    // The bytes each field takes (memory_use.hpp), as "nodes: FIELD".
+    void memory_use(MemoryUse& out) const;
 
     // --- state carried from step to step -------------------------------------------------
     std::array<std::vector<double>, 3> position;   // m
@@ -91,6 +95,8 @@ public:
     std::vector<std::uint8_t> fixed_mirror_planes;
 
 private:
+    // Calls f(name, field) for every per-node field: the one list of the fields that resizing,
+    // reordering, checkpoints and the memory report share.
     template <class F>
     void for_each_field(F&& f);
 

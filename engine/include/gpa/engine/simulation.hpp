@@ -40,6 +40,7 @@
 #include "gpa/engine/node_store.hpp"
 #include "gpa/engine/phase_graph.hpp"
 #include "gpa/engine/measure.hpp"
+#include "gpa/engine/memory_use.hpp"
 #include "gpa/engine/scene.hpp"
 
 namespace gpa {
@@ -185,6 +186,10 @@ public:
     // The neighbour lists of the last step: rows [0, real_count()) of the real nodes, then the
     // rows of the ghosts (indices >= real_count() are ghosts).
     const CompressedRows& neighbour_lists() const;
+    // The bytes the run's arrays take now, array by array (memory_use.hpp): node fields, neighbour
+    // lists and their caches, ghosts, and the scratch of each part of the step (particle bodies;
+    // element bodies are not counted yet).
+    MemoryUse memory_use() const;
 
     // --- checkpoints --------------------------------------------------------------------------
     // Writes everything later steps depend on (every node field, the ghosts, the neighbour lists
