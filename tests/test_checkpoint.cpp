@@ -160,10 +160,10 @@ TEST(Checkpoint, AResumedRunIsBitIdenticalToOneNeverStoppedOnOneAndTwoThreads) {
 }
 
 // The sections of a checkpoint, in the order Simulation::Impl::write_state writes them: the nodes
-// and ghosts, each part of the step that keeps state of its own (neighbour lists, energy ledger,
-// prescribed-velocity regions), the step's own time and totals.
+// and ghosts, each part of the step that keeps state of its own (neighbour lists, measures, energy
+// ledger, prescribed-velocity regions), the step's own time and totals.
 std::vector<std::pair<std::string, std::string>> sections_of(const std::string& bytes) {
-    static const std::vector<std::string> tags{"SIMU", "LIST", "TIME", "ENRG", "PVEL", "TOTL", "END."};
+    static const std::vector<std::string> tags{"SIMU", "LIST", "TIME", "MEAS", "ENRG", "PVEL", "TOTL", "END."};
     std::vector<std::pair<std::string, std::string>> out;
     std::size_t from = 0;
     std::vector<std::size_t> at;
@@ -204,7 +204,7 @@ TEST(Checkpoint, EveryPartRestoresItsOwnSectionExactly) {
         restore(restored, saved);
         const std::string again = checkpoint_of(restored);
         const auto a = sections_of(saved), b = sections_of(again);
-        ASSERT_EQ(a.size(), 6u);
+        ASSERT_EQ(a.size(), 7u);
         ASSERT_EQ(b.size(), a.size());
         for (std::size_t k = 0; k < a.size(); ++k) {
             EXPECT_TRUE(a[k].second == b[k].second) << "section " << a[k].first << " differs after a round trip ("

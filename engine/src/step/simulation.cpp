@@ -34,6 +34,7 @@
 #include "step/contact.hpp"
 #include "step/energy_ledger.hpp"
 #include "step/neighbour_lists.hpp"
+#include "step/measures.hpp"
 #include "step/regions.hpp"
 #include "step/switching.hpp"
 
@@ -42,25 +43,6 @@ namespace gpa {
 namespace {
 
 constexpr std::size_t reduce_grain = 4096;  // fixed, so that every sum has one order on any thread count
-
-struct Sums {
-    double kinetic = 0.0, internal = 0.0, plastic = 0.0, viscous = 0.0;
-    std::array<double, 3> momentum{0, 0, 0};
-    measure::Extent extent;
-    std::size_t variable = 0, failed = 0;
-
-    Sums& operator+=(const Sums& o) {
-        kinetic += o.kinetic;
-        internal += o.internal;
-        plastic += o.plastic;
-        viscous += o.viscous;
-        for (int c = 0; c < 3; ++c) momentum[c] += o.momentum[c];
-        extent += o.extent;
-        variable += o.variable;
-        failed += o.failed;
-        return *this;
-    }
-};
 
 }  // namespace
 
@@ -75,9 +57,8 @@ struct Simulation::Impl {
     NeighbourLists neighbour_lists;  // lists, skin cache, scatter plan (step/neighbour_lists.hpp)
     Contact contact;                 // separation and sliding state (step/contact.hpp)
     Switching switching_part;        // connectivity modes and the switching phase (step/switching.hpp)
+    Measures measures;               // sums, extents, local fields, half-step energies (step/measures.hpp)
     SmoothingScratch smoothing_scratch;
-    ImpactFrame impact;                    // body_report.hpp, from the initial state
-    std::vector<double> body_kinetic_half; // per body, like kinetic_half
     std::vector<double> largest_bond_q;  // per centre, the largest Q_ij of its pairs (for the time step)
     bool failed = false;                 // a phase threw: the state is half-updated
     std::unique_ptr<PhaseGraph> graph;
@@ -90,7 +71,6 @@ struct Simulation::Impl {
     double dt_next = 0.0;  // dt^{n+3/2}
     std::size_t steps = 0;
     double node_steps = 0.0;
-    double kinetic_half = 0.0;  // kinetic energy of the current half-step velocities
     std::vector<double> impulse;
     std::vector<double> reaction;
     Regions regions;      // prescribed-velocity regions (step/regions.hpp)
@@ -148,10 +128,7 @@ struct Simulation::Impl {
     template <class G>
     void smoothing();
     void sum_totals();
-    void sum_body_totals(bool advance_kinetic, const Sums* particle_sums = nullptr);
-    measure::Extent element_extent(const GhostPlane& plane, bool axisymmetric, double base = 0.0) const;
-    measure::Extent particle_extent(const GhostPlane& plane, bool axisymmetric, double base) const;
-    void measure_local_fields();
+    const GhostPlane* first_rigid_plane() const { return rigid_planes.empty() ? nullptr : &ghosts.planes()[rigid_planes.front()]; }
     void regroup_materials();
 };
 
@@ -185,12 +162,7 @@ void Simulation::Impl::setup() {
     switching_part.prepare_lattices(scene, nodes, real, planes.size() - scene.planes.size());
     for (const auto& m : scene.materials) materials::validate(m);
     initialise_material_state(nodes, real, scene.materials);
-    {
-        std::vector<std::array<double, 3>> body_velocity;
-        for (const auto& b : scene.bodies) body_velocity.push_back(b.velocity);
-        impact = impact_frame(nodes, real, body_velocity, scene.geometry == GeometryKind::Axisymmetric);
-        body_kinetic_half.assign(scene.bodies.size(), 0.0);
-    }
+    measures.set_up(scene, nodes, real);
     if (particles && scene.solver.reorder_interval > 0) reorder();
     regroup_materials();
     regions.index(nodes, real);
@@ -209,8 +181,8 @@ void Simulation::Impl::setup() {
     dt_half = 0.0;
     time_step();
     sum_totals();
-    const double kinetic_at_start = kinetic_half;
-    const std::vector<double> body_kinetic_at_start = body_kinetic_half;
+    const double kinetic_at_start = measures.half_step_kinetic();
+    const std::vector<double> body_kinetic_at_start = measures.body_half_step_kinetic();
     totals.initial_kinetic_energy = kinetic_at_start;
     totals.initial_energy = kinetic_at_start + totals.internal_energy;
     if (particles) forces<G>();
@@ -500,117 +472,11 @@ void Simulation::Impl::smoothing() {
     regions.book_smoothing(G::dim, nodes.mass.data(), smoothing_scratch.total_change);
 }
 
-void Simulation::Impl::sum_body_totals(bool advance_kinetic, const Sums* particle_sums) {
-    // Per body, the sums of sum_totals (one reduction with a slot per body; bodies are few). A
-    // scene of one body takes sum_totals' own sums instead of a second pass over the nodes.
-    const int d = dim();
-    const std::size_t bodies = scene.bodies.size();
-    if (bodies == 1 && particle_sums) {
-        totals.bodies.resize(1);
-        BodyTotals& t = totals.bodies[0];
-        t.name = scene.bodies[0].name;
-        if (t.mass == 0.0) t.mass = std::accumulate(nodes.mass.begin(), nodes.mass.begin() + real, 0.0);
-        if (advance_kinetic) {
-            t.kinetic_energy = 0.5 * (body_kinetic_half[0] + particle_sums->kinetic);
-            body_kinetic_half[0] = particle_sums->kinetic;
-        }
-        t.internal_energy = particle_sums->internal;
-        for (int c = 0; c < 3; ++c) {
-            t.momentum[c] = c < d ? particle_sums->momentum[c] : 0.0;
-            t.centre_velocity[c] = t.mass > 0.0 ? t.momentum[c] / t.mass : 0.0;
-        }
-        t.nodes = real;
-        t.failed_nodes = particle_sums->failed;
-        t.target = impact.defined && impact.target[0];
-        return;
-    }
-    struct BodySums {
-        std::vector<double> values;  // per body: mass, kinetic, internal, momentum[3], nodes, failed
-        BodySums& operator+=(const BodySums& o) {
-            if (values.empty()) {
-                values = o.values;
-            } else {
-                for (std::size_t k = 0; k < o.values.size(); ++k) values[k] += o.values[k];
-            }
-            return *this;
-        }
-    };
-    constexpr std::size_t slots = 8;
-    const BodySums s = tbb::parallel_deterministic_reduce(
-        tbb::blocked_range<std::size_t>(0, real, reduce_grain), BodySums{},
-        [&](const tbb::blocked_range<std::size_t>& r, BodySums acc) {
-            if (acc.values.empty()) acc.values.assign(bodies * slots, 0.0);
-            for (std::size_t i = r.begin(); i != r.end(); ++i) {
-                double* v = acc.values.data() + static_cast<std::size_t>(nodes.body[i]) * slots;
-                const double m = nodes.mass[i];
-                double v2 = 0.0;
-                for (int c = 0; c < d; ++c) {
-                    v2 += nodes.velocity[c][i] * nodes.velocity[c][i];
-                    v[3 + c] += m * nodes.velocity[c][i];
-                }
-                v[0] += m;
-                v[1] += 0.5 * m * v2;
-                v[2] += m * nodes.internal_energy[i];
-                v[6] += 1.0;
-                v[7] += nodes.failed[i] != 0;
-            }
-            return acc;
-        },
-        [](BodySums x, const BodySums& y) { return x += y; });
-    totals.bodies.resize(bodies);
-    for (std::size_t b = 0; b < bodies; ++b) {
-        BodyTotals& t = totals.bodies[b];
-        t.name = scene.bodies[b].name;
-        const double* v = s.values.empty() ? nullptr : s.values.data() + b * slots;
-        const double kinetic = v ? v[1] : 0.0;
-        t.mass = v ? v[0] : 0.0;
-        if (advance_kinetic) {
-            t.kinetic_energy = 0.5 * (body_kinetic_half[b] + kinetic);
-            body_kinetic_half[b] = kinetic;
-        }
-        t.internal_energy = v ? v[2] : 0.0;
-        for (int c = 0; c < 3; ++c) {
-            t.momentum[c] = v && c < d ? v[3 + c] : 0.0;
-            t.centre_velocity[c] = t.mass > 0.0 ? t.momentum[c] / t.mass : 0.0;
-        }
-        t.nodes = v ? static_cast<std::size_t>(v[6]) : 0;
-        t.failed_nodes = v ? static_cast<std::size_t>(v[7]) : 0;
-        t.target = impact.defined && impact.target[b];
-    }
-}
-
 void Simulation::Impl::sum_totals() {
-    const int d = dim();
-    const GhostPlane* plane = rigid_planes.empty() ? nullptr : &ghosts.planes()[rigid_planes.front()];
+    const GhostPlane* plane = first_rigid_plane();
     const bool axisymmetric = scene.geometry == GeometryKind::Axisymmetric;
-    const Sums s = tbb::parallel_deterministic_reduce(
-        tbb::blocked_range<std::size_t>(0, real, reduce_grain), Sums{},
-        [&](const tbb::blocked_range<std::size_t>& r, Sums acc) {
-            for (std::size_t i = r.begin(); i != r.end(); ++i) {
-                const double m = nodes.mass[i];
-                double v2 = 0.0;
-                for (int c = 0; c < d; ++c) {
-                    v2 += nodes.velocity[c][i] * nodes.velocity[c][i];
-                    acc.momentum[c] += m * nodes.velocity[c][i];
-                }
-                acc.kinetic += 0.5 * m * v2;
-                acc.internal += m * nodes.internal_energy[i];
-                acc.plastic += m * nodes.plastic_work[i];
-                acc.viscous += m * nodes.viscous_work[i];
-                acc.variable += nodes.connectivity[i] == Connectivity::Variable;
-                acc.failed += nodes.failed[i] != 0;
-                if (plane) {
-                    // Width across the plane's first other axis (radius x in axisymmetric geometry).
-                    const int across = plane->axis == 0 ? 1 : 0;
-                    measure::add_particle(acc.extent, plane->distance(nodes.position[plane->axis][i]),
-                                          nodes.position[across][i], measure::particle_cell_size(nodes.size_weight[i], d),
-                                          axisymmetric && across == 0);
-                }
-            }
-            return acc;
-        },
-        [](Sums x, const Sums& y) { return x += y; });
-    Sums all = s;
+    const NodeSums s = measures.node_sums(nodes, real, plane, axisymmetric);
+    NodeSums all = s;
     double element_boundary_work = 0.0;
     if (elements) {
         const ElementPart::Sums e = elements->sums();
@@ -620,11 +486,10 @@ void Simulation::Impl::sum_totals() {
         all.viscous += e.viscous;
         for (int c = 0; c < 2; ++c) all.momentum[c] += e.momentum[c];
         element_boundary_work = elements->boundary_work();
-        if (plane) all.extent += element_extent(*plane, axisymmetric);
+        if (plane) all.extent += Measures::element_extent(elements->mesh(), *plane, axisymmetric);
     }
     // Kinetic energy at an integer time: the mean of the half steps around it (spec section 11).
-    totals.kinetic_energy = 0.5 * (kinetic_half + all.kinetic);
-    kinetic_half = all.kinetic;
+    totals.kinetic_energy = measures.advance_kinetic(all.kinetic);
     totals.internal_energy = all.internal;
     totals.plastic_work = all.plastic;
     totals.viscous_work = all.viscous;
@@ -649,8 +514,8 @@ void Simulation::Impl::sum_totals() {
     totals.base_height = 0.0;
     if (plane && shape.seen() && !shape.standing()) {
         totals.base_height = shape.lowest;
-        shape = particle_extent(*plane, axisymmetric, totals.base_height);
-        if (elements) shape += element_extent(*plane, axisymmetric, totals.base_height);
+        shape = measures.particle_extent(nodes, real, *plane, axisymmetric, totals.base_height);
+        if (elements) shape += Measures::element_extent(elements->mesh(), *plane, axisymmetric, totals.base_height);
     }
     totals.length = plane ? shape.length() : 0.0;
     totals.footprint_diameter = plane ? shape.footprint() : 0.0;
@@ -668,7 +533,7 @@ void Simulation::Impl::sum_totals() {
         const double element_impulse = elements ? elements->impulses()[k] : 0.0;
         totals.planes.push_back({ghosts.planes()[rigid_planes[k]].name, reaction[k] + element_reaction, impulse[k] + element_impulse});
     }
-    sum_body_totals(true, &s);
+    measures.body_totals(scene, nodes, real, true, &s, totals.bodies);
     totals.energy_given = totals.initial_energy + std::max(0.0, region_work_now);
     if (totals.energy_given != 0.0) {
         // With the compatible energy update the internal energy has been booked up to the velocities
@@ -679,38 +544,6 @@ void Simulation::Impl::sum_totals() {
         totals.energy_error = (kinetic + totals.internal_energy + totals.boundary_work - totals.initial_energy) /
                               totals.energy_given;
     }
-}
-
-measure::Extent Simulation::Impl::particle_extent(const GhostPlane& plane, bool axisymmetric, double base) const {
-    const int across = plane.axis == 0 ? 1 : 0;
-    return tbb::parallel_deterministic_reduce(
-        tbb::blocked_range<std::size_t>(0, real, reduce_grain), measure::Extent{},
-        [&](const tbb::blocked_range<std::size_t>& r, measure::Extent acc) {
-            for (std::size_t i = r.begin(); i != r.end(); ++i) {
-                measure::add_particle(acc, plane.distance(nodes.position[plane.axis][i]) - base, nodes.position[across][i],
-                                      measure::particle_cell_size(nodes.size_weight[i], dim()), axisymmetric && across == 0);
-            }
-            return acc;
-        },
-        [](measure::Extent x, const measure::Extent& y) { return x += y; });
-}
-
-measure::Extent Simulation::Impl::element_extent(const GhostPlane& plane, bool axisymmetric, double base) const {
-    // The element rule of measure.hpp: nodes lie on the boundary (no d/2), "on the plane" within
-    // the face tolerance of the node's body.
-    const ElementMesh& m = elements->mesh();
-    const int across = plane.axis == 0 ? 1 : 0;
-    return tbb::parallel_reduce(
-        tbb::blocked_range<std::size_t>(0, m.nodes.size(), reduce_grain), measure::Extent{},
-        [&](const tbb::blocked_range<std::size_t>& r, measure::Extent acc) {
-            for (std::size_t i = r.begin(); i != r.end(); ++i) {
-                const double spacing = m.body_spacing[static_cast<std::size_t>(m.nodes.body[i])];
-                measure::add_element_node(acc, plane.distance(m.nodes.position[plane.axis][i]) - base, m.nodes.position[across][i],
-                                          measure::element_face_tolerance(spacing), axisymmetric && across == 0);
-            }
-            return acc;
-        },
-        [](measure::Extent x, const measure::Extent& y) { return x += y; });
 }
 
 template <class G>
@@ -840,82 +673,13 @@ const NodeStore& Simulation::nodes() const { return impl_->nodes; }
 std::size_t Simulation::real_count() const { return impl_->real; }
 const Totals& Simulation::totals() const { return impl_->totals; }
 void Simulation::measure_bodies() {
-    impl_->measure_local_fields();
-    if (!impl_->particles) return;
-    gpa::measure_bodies(impl_->nodes, impl_->real, impl_->lists(), impl_->impact, impl_->totals.bodies);
+    Impl& im = *impl_;
+    im.measures.local_fields(im.scene, im.nodes, im.real, im.first_rigid_plane(), im.elements.get(), im.totals.base_height,
+                             im.totals.local);
+    if (!im.particles) return;
+    gpa::measure_bodies(im.nodes, im.real, im.lists(), im.measures.impact(), im.totals.bodies);
 }
 
-void Simulation::Impl::measure_local_fields() {
-    // measure.hpp: peaks over a neighbourhood of the same radius for particle nodes and element
-    // triangles; the face roughness over the points on the body's base.
-    auto& out = totals.local;
-    out.radius = scene.output.peak_radius > 0.0 ? scene.output.peak_radius
-                 : scene.bodies.empty()        ? 0.0
-                                               : 2.0 * scene.bodies.front().spacing;
-    out.measured = out.radius > 0.0;
-    if (!out.measured) return;
-    const int d = dim();
-    const GhostPlane* plane = rigid_planes.empty() ? nullptr : &ghosts.planes()[rigid_planes.front()];
-    const int across = plane && plane->axis == 0 ? 1 : 0;
-    std::vector<measure::FieldPoint> strain, heat;
-    std::vector<double> face_across, face_value;
-    // The face row of particles: nodes on the base now that started in the lattice row nearest
-    // the plane (below the next row up), so that a second row pressed down does not mix in.
-    double first_row = INFINITY;
-    if (plane) {
-        for (std::size_t i = 0; i < real; ++i) first_row = std::min(first_row, plane->distance(nodes.initial_position[plane->axis][i]));
-    }
-    for (std::size_t i = 0; i < real; ++i) {
-        measure::FieldPoint p;
-        for (int c = 0; c < d; ++c) p.position[c] = nodes.position[c][i];
-        p.weight = nodes.size_weight[i];
-        p.body = nodes.body[i];
-        p.value = nodes.plastic_strain[i];
-        strain.push_back(p);
-        p.value = nodes.temperature[i];
-        heat.push_back(p);
-        if (plane && plane->distance(nodes.position[plane->axis][i]) - totals.base_height < measure::particle_cell_size(nodes.size_weight[i], d) &&
-            plane->distance(nodes.initial_position[plane->axis][i]) - first_row < 0.5 * nodes.initial_diameter[i]) {
-            face_across.push_back(nodes.position[across][i]);
-            face_value.push_back(nodes.plastic_strain[i]);
-        }
-    }
-    if (elements) {
-        const ElementMesh& m = elements->mesh();
-        for (std::size_t q = 0; q < m.quads.size(); ++q) {
-            const auto& n = m.quads.nodes[q];
-            for (int k = 0; k < 4; ++k) {
-                const NodeIndex a = n[4], b = n[k], c = n[(k + 1) % 4];
-                const std::size_t t = 4 * q + static_cast<std::size_t>(k);
-                measure::FieldPoint p;
-                for (int x = 0; x < 2; ++x) {
-                    p.position[x] = (m.nodes.position[x][a] + m.nodes.position[x][b] + m.nodes.position[x][c]) / 3.0;
-                }
-                p.weight = 0.5 * std::abs((m.nodes.position[0][b] - m.nodes.position[0][a]) * (m.nodes.position[1][c] - m.nodes.position[1][a]) -
-                                          (m.nodes.position[1][b] - m.nodes.position[1][a]) * (m.nodes.position[0][c] - m.nodes.position[0][a]));
-                p.body = m.quads.body[q];
-                p.value = m.points.plastic_strain[t];
-                strain.push_back(p);
-                p.value = m.points.temperature[t];
-                heat.push_back(p);
-                if (plane) {
-                    // A triangle whose outer edge lies on the base.
-                    const double tol = measure::element_face_tolerance(m.body_spacing[static_cast<std::size_t>(m.quads.body[q])]);
-                    const double hb = plane->distance(m.nodes.position[plane->axis][b]) - totals.base_height;
-                    const double hc = plane->distance(m.nodes.position[plane->axis][c]) - totals.base_height;
-                    if (hb <= tol && hc <= tol) {
-                        face_across.push_back(p.position[across]);
-                        face_value.push_back(m.points.plastic_strain[t]);
-                    }
-                }
-            }
-        }
-    }
-    out.plastic_strain = measure::local_peak(strain, out.radius, d);
-    out.temperature = measure::local_peak(heat, out.radius, d);
-    out.face_roughness = measure::face_roughness(face_across, face_value);
-    out.face_points = face_value.size();
-}
 double Simulation::time() const { return impl_->time; }
 std::size_t Simulation::steps() const { return impl_->steps; }
 double Simulation::next_time_step() const { return impl_->dt_half; }
@@ -1119,12 +883,11 @@ void Simulation::Impl::write_state(StateWriter& out) const {
     out.value<double>(dt_next);
     out.value<std::uint64_t>(steps);
     out.value<double>(node_steps);
-    out.value<double>(kinetic_half);
-    out.array(body_kinetic_half);
     out.value<std::uint64_t>(totals.bodies.size());
     for (const auto& b : totals.bodies) out.value<double>(b.kinetic_energy);
     out.array(impulse);
     out.array(reaction);
+    measures.write_state(out);
     ledger.write_state(out);
     regions.write_state(out);
     out.tag("TOTL");
@@ -1179,14 +942,12 @@ void Simulation::Impl::read_state(StateReader& in) {
     dt_next = in.value<double>();
     steps = static_cast<std::size_t>(in.value<std::uint64_t>());
     node_steps = in.value<double>();
-    kinetic_half = in.value<double>();
-    in.array(body_kinetic_half);
-    if (body_kinetic_half.size() != scene.bodies.size()) in.fail("its bodies are not the scene's");
     std::vector<double> body_kinetic(static_cast<std::size_t>(in.value<std::uint64_t>()));
     if (body_kinetic.size() != scene.bodies.size()) in.fail("its bodies are not the scene's");
     for (double& k : body_kinetic) k = in.value<double>();
     in.array(impulse);
     in.array(reaction);
+    measures.read_state(in, scene.bodies.size());
     if (impulse.size() != rigid_planes.size() || reaction.size() != rigid_planes.size()) in.fail("its planes are not the scene's");
     ledger.read_state(in);
     regions.read_state(in);
@@ -1232,7 +993,7 @@ void Simulation::Impl::read_state(StateReader& in) {
     graph->restore_times(times);
     in.tag("END.");
     regroup_materials();
-    sum_body_totals(false);
+    measures.body_totals(scene, nodes, real, false, nullptr, totals.bodies);
     for (std::size_t b = 0; b < body_kinetic.size(); ++b) totals.bodies[b].kinetic_energy = body_kinetic[b];
     // The held nodes in the checkpoint's numbering: the same count per region as the scene's.
     regions.check_restored(in, nodes, real);

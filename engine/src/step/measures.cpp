@@ -1,0 +1,265 @@
+#include "step/measures.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_reduce.h>
+
+namespace gpa {
+
+namespace {
+constexpr std::size_t reduce_grain = 4096;  // fixed, so that every sum has one order on any thread count
+}  // namespace
+
+NodeSums& NodeSums::operator+=(const NodeSums& o) {
+    kinetic += o.kinetic;
+    internal += o.internal;
+    plastic += o.plastic;
+    viscous += o.viscous;
+    for (int c = 0; c < 3; ++c) momentum[c] += o.momentum[c];
+    extent += o.extent;
+    variable += o.variable;
+    failed += o.failed;
+    return *this;
+}
+
+void Measures::set_up(const Scene& scene, const NodeStore& nodes, std::size_t real) {
+    std::vector<std::array<double, 3>> body_velocity;
+    for (const auto& b : scene.bodies) body_velocity.push_back(b.velocity);
+    impact_ = impact_frame(nodes, real, body_velocity, scene.geometry == GeometryKind::Axisymmetric);
+    body_kinetic_half_.assign(scene.bodies.size(), 0.0);
+}
+
+double Measures::advance_kinetic(double half_step_now) {
+    const double at_integer_time = 0.5 * (kinetic_half_ + half_step_now);
+    kinetic_half_ = half_step_now;
+    return at_integer_time;
+}
+
+NodeSums Measures::node_sums(const NodeStore& nodes, std::size_t real, const GhostPlane* plane, bool axisymmetric) const {
+    const int d = nodes.dim();
+    return tbb::parallel_deterministic_reduce(
+        tbb::blocked_range<std::size_t>(0, real, reduce_grain), NodeSums{},
+        [&](const tbb::blocked_range<std::size_t>& r, NodeSums acc) {
+            for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                const double m = nodes.mass[i];
+                double v2 = 0.0;
+                for (int c = 0; c < d; ++c) {
+                    v2 += nodes.velocity[c][i] * nodes.velocity[c][i];
+                    acc.momentum[c] += m * nodes.velocity[c][i];
+                }
+                acc.kinetic += 0.5 * m * v2;
+                acc.internal += m * nodes.internal_energy[i];
+                acc.plastic += m * nodes.plastic_work[i];
+                acc.viscous += m * nodes.viscous_work[i];
+                acc.variable += nodes.connectivity[i] == Connectivity::Variable;
+                acc.failed += nodes.failed[i] != 0;
+                if (plane) {
+                    // Width across the plane's first other axis (radius x in axisymmetric geometry).
+                    const int across = plane->axis == 0 ? 1 : 0;
+                    measure::add_particle(acc.extent, plane->distance(nodes.position[plane->axis][i]),
+                                          nodes.position[across][i], measure::particle_cell_size(nodes.size_weight[i], d),
+                                          axisymmetric && across == 0);
+                }
+            }
+            return acc;
+        },
+        [](NodeSums x, const NodeSums& y) { return x += y; });
+}
+
+measure::Extent Measures::particle_extent(const NodeStore& nodes, std::size_t real, const GhostPlane& plane, bool axisymmetric,
+                                          double base) const {
+    const int across = plane.axis == 0 ? 1 : 0;
+    return tbb::parallel_deterministic_reduce(
+        tbb::blocked_range<std::size_t>(0, real, reduce_grain), measure::Extent{},
+        [&](const tbb::blocked_range<std::size_t>& r, measure::Extent acc) {
+            for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                measure::add_particle(acc, plane.distance(nodes.position[plane.axis][i]) - base, nodes.position[across][i],
+                                      measure::particle_cell_size(nodes.size_weight[i], nodes.dim()), axisymmetric && across == 0);
+            }
+            return acc;
+        },
+        [](measure::Extent x, const measure::Extent& y) { return x += y; });
+}
+
+measure::Extent Measures::element_extent(const ElementMesh& m, const GhostPlane& plane, bool axisymmetric, double base) {
+    // The element rule of measure.hpp: nodes lie on the boundary (no d/2), "on the plane" within
+    // the face tolerance of the node's body.
+    const int across = plane.axis == 0 ? 1 : 0;
+    return tbb::parallel_reduce(
+        tbb::blocked_range<std::size_t>(0, m.nodes.size(), reduce_grain), measure::Extent{},
+        [&](const tbb::blocked_range<std::size_t>& r, measure::Extent acc) {
+            for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                const double spacing = m.body_spacing[static_cast<std::size_t>(m.nodes.body[i])];
+                measure::add_element_node(acc, plane.distance(m.nodes.position[plane.axis][i]) - base, m.nodes.position[across][i],
+                                          measure::element_face_tolerance(spacing), axisymmetric && across == 0);
+            }
+            return acc;
+        },
+        [](measure::Extent x, const measure::Extent& y) { return x += y; });
+}
+
+void Measures::body_totals(const Scene& scene, const NodeStore& nodes, std::size_t real, bool advance_kinetic,
+                           const NodeSums* particle_sums, std::vector<BodyTotals>& out) {
+    const int d = nodes.dim();
+    const std::size_t bodies = scene.bodies.size();
+    if (bodies == 1 && particle_sums) {
+        out.resize(1);
+        BodyTotals& t = out[0];
+        t.name = scene.bodies[0].name;
+        if (t.mass == 0.0) t.mass = std::accumulate(nodes.mass.begin(), nodes.mass.begin() + real, 0.0);
+        if (advance_kinetic) {
+            t.kinetic_energy = 0.5 * (body_kinetic_half_[0] + particle_sums->kinetic);
+            body_kinetic_half_[0] = particle_sums->kinetic;
+        }
+        t.internal_energy = particle_sums->internal;
+        for (int c = 0; c < 3; ++c) {
+            t.momentum[c] = c < d ? particle_sums->momentum[c] : 0.0;
+            t.centre_velocity[c] = t.mass > 0.0 ? t.momentum[c] / t.mass : 0.0;
+        }
+        t.nodes = real;
+        t.failed_nodes = particle_sums->failed;
+        t.target = impact_.defined && impact_.target[0];
+        return;
+    }
+    struct BodySums {
+        std::vector<double> values;  // per body: mass, kinetic, internal, momentum[3], nodes, failed
+        BodySums& operator+=(const BodySums& o) {
+            if (values.empty()) {
+                values = o.values;
+            } else {
+                for (std::size_t k = 0; k < o.values.size(); ++k) values[k] += o.values[k];
+            }
+            return *this;
+        }
+    };
+    constexpr std::size_t slots = 8;
+    const BodySums s = tbb::parallel_deterministic_reduce(
+        tbb::blocked_range<std::size_t>(0, real, reduce_grain), BodySums{},
+        [&](const tbb::blocked_range<std::size_t>& r, BodySums acc) {
+            if (acc.values.empty()) acc.values.assign(bodies * slots, 0.0);
+            for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                double* v = acc.values.data() + static_cast<std::size_t>(nodes.body[i]) * slots;
+                const double m = nodes.mass[i];
+                double v2 = 0.0;
+                for (int c = 0; c < d; ++c) {
+                    v2 += nodes.velocity[c][i] * nodes.velocity[c][i];
+                    v[3 + c] += m * nodes.velocity[c][i];
+                }
+                v[0] += m;
+                v[1] += 0.5 * m * v2;
+                v[2] += m * nodes.internal_energy[i];
+                v[6] += 1.0;
+                v[7] += nodes.failed[i] != 0;
+            }
+            return acc;
+        },
+        [](BodySums x, const BodySums& y) { return x += y; });
+    out.resize(bodies);
+    for (std::size_t b = 0; b < bodies; ++b) {
+        BodyTotals& t = out[b];
+        t.name = scene.bodies[b].name;
+        const double* v = s.values.empty() ? nullptr : s.values.data() + b * slots;
+        const double kinetic = v ? v[1] : 0.0;
+        t.mass = v ? v[0] : 0.0;
+        if (advance_kinetic) {
+            t.kinetic_energy = 0.5 * (body_kinetic_half_[b] + kinetic);
+            body_kinetic_half_[b] = kinetic;
+        }
+        t.internal_energy = v ? v[2] : 0.0;
+        for (int c = 0; c < 3; ++c) {
+            t.momentum[c] = v && c < d ? v[3 + c] : 0.0;
+            t.centre_velocity[c] = t.mass > 0.0 ? t.momentum[c] / t.mass : 0.0;
+        }
+        t.nodes = v ? static_cast<std::size_t>(v[6]) : 0;
+        t.failed_nodes = v ? static_cast<std::size_t>(v[7]) : 0;
+        t.target = impact_.defined && impact_.target[b];
+    }
+}
+
+void Measures::local_fields(const Scene& scene, const NodeStore& nodes, std::size_t real, const GhostPlane* plane,
+                            const ElementPart* elements, double base_height, Totals::LocalFields& out) const {
+    // measure.hpp: peaks over a neighbourhood of the same radius for particle nodes and element
+    // triangles; the face roughness over the points on the body's base.
+    out.radius = scene.output.peak_radius > 0.0 ? scene.output.peak_radius
+                 : scene.bodies.empty()        ? 0.0
+                                               : 2.0 * scene.bodies.front().spacing;
+    out.measured = out.radius > 0.0;
+    if (!out.measured) return;
+    const int d = nodes.dim();
+    const int across = plane && plane->axis == 0 ? 1 : 0;
+    std::vector<measure::FieldPoint> strain, heat;
+    std::vector<double> face_across, face_value;
+    // The face row of particles: nodes on the base now that started in the lattice row nearest
+    // the plane (below the next row up), so that a second row pressed down does not mix in.
+    double first_row = INFINITY;
+    if (plane) {
+        for (std::size_t i = 0; i < real; ++i) first_row = std::min(first_row, plane->distance(nodes.initial_position[plane->axis][i]));
+    }
+    for (std::size_t i = 0; i < real; ++i) {
+        measure::FieldPoint p;
+        for (int c = 0; c < d; ++c) p.position[c] = nodes.position[c][i];
+        p.weight = nodes.size_weight[i];
+        p.body = nodes.body[i];
+        p.value = nodes.plastic_strain[i];
+        strain.push_back(p);
+        p.value = nodes.temperature[i];
+        heat.push_back(p);
+        if (plane && plane->distance(nodes.position[plane->axis][i]) - base_height < measure::particle_cell_size(nodes.size_weight[i], d) &&
+            plane->distance(nodes.initial_position[plane->axis][i]) - first_row < 0.5 * nodes.initial_diameter[i]) {
+            face_across.push_back(nodes.position[across][i]);
+            face_value.push_back(nodes.plastic_strain[i]);
+        }
+    }
+    if (elements) {
+        const ElementMesh& m = elements->mesh();
+        for (std::size_t q = 0; q < m.quads.size(); ++q) {
+            const auto& n = m.quads.nodes[q];
+            for (int k = 0; k < 4; ++k) {
+                const NodeIndex a = n[4], b = n[k], c = n[(k + 1) % 4];
+                const std::size_t t = 4 * q + static_cast<std::size_t>(k);
+                measure::FieldPoint p;
+                for (int x = 0; x < 2; ++x) {
+                    p.position[x] = (m.nodes.position[x][a] + m.nodes.position[x][b] + m.nodes.position[x][c]) / 3.0;
+                }
+                p.weight = 0.5 * std::abs((m.nodes.position[0][b] - m.nodes.position[0][a]) * (m.nodes.position[1][c] - m.nodes.position[1][a]) -
+                                          (m.nodes.position[1][b] - m.nodes.position[1][a]) * (m.nodes.position[0][c] - m.nodes.position[0][a]));
+                p.body = m.quads.body[q];
+                p.value = m.points.plastic_strain[t];
+                strain.push_back(p);
+                p.value = m.points.temperature[t];
+                heat.push_back(p);
+                if (plane) {
+                    // A triangle whose outer edge lies on the base.
+                    const double tol = measure::element_face_tolerance(m.body_spacing[static_cast<std::size_t>(m.quads.body[q])]);
+                    const double hb = plane->distance(m.nodes.position[plane->axis][b]) - base_height;
+                    const double hc = plane->distance(m.nodes.position[plane->axis][c]) - base_height;
+                    if (hb <= tol && hc <= tol) {
+                        face_across.push_back(p.position[across]);
+                        face_value.push_back(m.points.plastic_strain[t]);
+                    }
+                }
+            }
+        }
+    }
+    out.plastic_strain = measure::local_peak(strain, out.radius, d);
+    out.temperature = measure::local_peak(heat, out.radius, d);
+    out.face_roughness = measure::face_roughness(face_across, face_value);
+    out.face_points = face_value.size();
+}
+void Measures::write_state(StateWriter& out) const {
+    out.tag("MEAS");
+    out.value<double>(kinetic_half_);
+    out.array(body_kinetic_half_);
+}
+
+void Measures::read_state(StateReader& in, std::size_t bodies) {
+    in.tag("MEAS");
+    kinetic_half_ = in.value<double>();
+    in.array(body_kinetic_half_);
+    if (body_kinetic_half_.size() != bodies) in.fail("its bodies are not the scene's");
+}
+
+}  // namespace gpa
