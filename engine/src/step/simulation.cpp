@@ -36,6 +36,7 @@
 #include "step/neighbour_lists.hpp"
 #include "step/measures.hpp"
 #include "step/regions.hpp"
+#include "step/run_control.hpp"
 #include "step/switching.hpp"
 
 namespace gpa {
@@ -79,13 +80,11 @@ struct Simulation::Impl {
     std::string stop_reason;
 
     // --- limits, failure reports and checkpoints (the last section of this file) ---------
-    MemoryLimit memory_limit;
-    StepFailure step_failure(const std::exception& e, const std::string& phase) const;
-    void check_step(double time_before);  // the energy guard; time must advance
+    RunControl run_control;  // stop criteria, limits, failure reports (step/run_control.hpp)
     void write_state(StateWriter& out) const;
     void read_state(StateReader& in);
 
-    Impl(Scene s, int thread_count)
+    Impl(Scene s, int thread_count, MemoryLimit memory)
         : scene(std::move(s)),
           threads(thread_count),
           nodes(scene.geometry),
@@ -93,7 +92,8 @@ struct Simulation::Impl {
           contact(scene),
           switching_part(scene),
           regions(scene.prescribed_velocities),
-          ledger(scene.solver) {}
+          ledger(scene.solver),
+          run_control(scene, std::move(memory)) {}
 
     int dim() const { return nodes.dim(); }
     double a() const { return scene.solver.influence_distance; }
@@ -601,23 +601,13 @@ void Simulation::Impl::build_phase_graph() {
 }
 
 Simulation::Simulation(Scene scene, int threads, MemoryLimit memory)
-    : impl_(std::make_unique<Impl>(std::move(scene), threads)) {
+    : impl_(std::make_unique<Impl>(std::move(scene), threads, memory)) {
     // Sizes from the input, checked before they are allocated: the nodes here, the neighbour
     // lists before every search.
     validate_scene(impl_->scene);
     check_scene_memory(impl_->scene, memory);
-    impl_->memory_limit = std::move(memory);
-    impl_->neighbour_lists.set_entry_check([im = impl_.get()](std::size_t entries) {
-        const int dim = im->dim();
-        const double bytes = double(im->nodes.size()) * bytes_per_node_besides_lists(dim) +
-                             double(entries) * bytes_per_list_entry;
-        if (bytes > double(limit_bytes(im->memory_limit))) {
-            throw LimitError(fmt::format("the neighbour lists would hold {} pairs ({:.3g} per node), an estimated {} of "
-                                         "memory with the nodes; {}",
-                                         entries, double(entries) / double(std::max<std::size_t>(im->real, 1)),
-                                         format_bytes(bytes), describe_limit(im->memory_limit)));
-        }
-    });
+    impl_->neighbour_lists.set_entry_check(
+        [im = impl_.get()](std::size_t entries) { im->run_control.check_list_memory(im->nodes, im->real, entries); });
     impl_->threads.run([this] {
         dispatch_geometry(impl_->scene.geometry, [this](auto g) { impl_->setup<decltype(g)>(); });
     });
@@ -635,32 +625,23 @@ void Simulation::step() {
         impl_->threads.run([this] { impl_->graph->run(); });
     } catch (const std::exception& e) {
         impl_->failed = true;
-        throw impl_->step_failure(e, impl_->graph->failed_phase());
+        throw impl_->run_control.step_failure(e, impl_->graph->failed_phase(), impl_->steps, impl_->time, impl_->nodes,
+                                              impl_->real);
     } catch (...) {
         impl_->failed = true;
         throw;
     }
-    impl_->check_step(time_before);
+    try {
+        impl_->run_control.check_step(time_before, impl_->time, impl_->dt_half, impl_->steps, impl_->totals, impl_->nodes,
+                                      impl_->real);
+    } catch (...) {
+        impl_->failed = true;
+        throw;
+    }
 }
 
 bool Simulation::finished() const {
-    const auto& s = impl_->scene.stop;
-    const auto& t = impl_->totals;
-    auto& reason = impl_->stop_reason;
-    if (s.end_time > 0.0 && impl_->time >= s.end_time * (1.0 - 1e-12)) {
-        reason = fmt::format("end time {:.6g} s reached", s.end_time);
-        return true;
-    }
-    if (s.kinetic_energy_fraction > 0.0 && impl_->steps > 0 &&
-        t.kinetic_energy < s.kinetic_energy_fraction * t.initial_kinetic_energy) {
-        reason = fmt::format("kinetic energy below {:g} % of its initial value", 100.0 * s.kinetic_energy_fraction);
-        return true;
-    }
-    if (s.max_steps > 0 && impl_->steps >= s.max_steps) {
-        reason = fmt::format("{} steps done", s.max_steps);
-        return true;
-    }
-    return false;
+    return impl_->run_control.finished(impl_->time, impl_->steps, impl_->totals, impl_->stop_reason);
 }
 
 std::string Simulation::stop_reason() const {
@@ -710,138 +691,6 @@ MemoryUse Simulation::memory_use() const {
 }
 
 // --- limits, failure reports and checkpoints ----------------------------------------------
-
-namespace {
-
-std::string component_name(int dim, int c) { return dim == 2 ? (c == 0 ? "x" : "z") : std::string(1, "xyz"[c]); }
-
-std::string stress_name(GeometryKind g, int c) {
-    if (g == GeometryKind::ThreeD) return std::array<const char*, 6>{"xx", "yy", "zz", "yz", "xz", "xy"}[c];
-    return std::array<const char*, 4>{"xx", "zz", "xz", g == GeometryKind::Axisymmetric ? "tt" : "yy"}[c];
-}
-
-// The first real node (lowest index) with a non-finite value in a field a step writes, and
-// that field's name.
-std::optional<std::pair<std::size_t, std::string>> first_non_finite(const NodeStore& n, std::size_t real) {
-    const int d = n.dim();
-    std::vector<std::pair<std::string, const std::vector<double>*>> fields;
-    for (int c = 0; c < d; ++c) fields.push_back({"position " + component_name(d, c), &n.position[c]});
-    for (int c = 0; c < d; ++c) fields.push_back({"velocity " + component_name(d, c), &n.velocity[c]});
-    fields.push_back({"volume", &n.volume});
-    fields.push_back({"diameter", &n.diameter});
-    fields.push_back({"volumetric strain", &n.volumetric_strain});
-    for (int c = 0; c < d * d; ++c) {
-        fields.push_back({"velocity gradient " + component_name(d, c / d) + component_name(d, c % d), &n.velocity_gradient[c]});
-    }
-    for (int c = 0; c < d; ++c) fields.push_back({"alpha " + component_name(d, c), &n.alpha[c]});
-    for (int c = 0; c < stress_components(d); ++c) {
-        fields.push_back({"deviatoric stress " + stress_name(n.geometry(), c), &n.deviatoric_stress[c]});
-    }
-    fields.push_back({"pressure", &n.pressure});
-    fields.push_back({"viscous pressure", &n.viscous_pressure});
-    fields.push_back({"sound speed", &n.sound_speed});
-    fields.push_back({"internal energy", &n.internal_energy});
-    fields.push_back({"stable length", &n.stable_length});
-    for (int c = 0; c < d; ++c) fields.push_back({"force " + component_name(d, c), &n.force[c]});
-    std::optional<std::pair<std::size_t, std::string>> found;
-    for (const auto& [name, field] : fields) {
-        const std::size_t count = std::min(real, field->size());
-        for (std::size_t i = 0; i < count && (!found || i < found->first); ++i) {
-            if (!std::isfinite((*field)[i])) {
-                found = std::pair{i, name};
-                break;
-            }
-        }
-    }
-    return found;
-}
-
-std::string describe_site(const FailureSite& f) {
-    std::string text = fmt::format("step {} at t = {:.6g} us, phase \"{}\"", f.step, f.time * 1e6, f.phase);
-    if (f.node) {
-        text += fmt::format(": node {}", *f.node);
-        if (!f.body.empty()) text += fmt::format(" of body \"{}\"", f.body);
-        text += " at (";
-        for (int c = 0; c < f.dim; ++c) text += fmt::format("{}{:.6g}", c ? ", " : "", f.position[c] * 1e3);
-        text += ") mm";
-    }
-    if (!f.field.empty()) text += fmt::format(", field {}", f.field);
-    return text + ": " + f.cause;
-}
-
-}  // namespace
-
-StepFailure Simulation::Impl::step_failure(const std::exception& e, const std::string& phase) const {
-    FailureSite site;
-    site.step = steps + 1;  // the totals phase counts a step when it completes
-    site.time = time;
-    site.phase = phase.empty() ? "step" : phase;
-    site.dim = dim();
-    site.cause = e.what();
-    if (const auto* numerical = dynamic_cast<const NumericalError*>(&e); numerical && numerical->node()) {
-        site.node = numerical->node();
-        site.field = numerical->field();
-    } else if (dynamic_cast<const NumericalError*>(&e) || dynamic_cast<const InputError*>(&e)) {
-        // The kernel did not say which node: the first with a value that is not a number.
-        if (const auto bad = first_non_finite(nodes, real)) {
-            site.node = bad->first;
-            site.field = bad->second;
-        }
-    }
-    if (site.node && *site.node < nodes.size()) {
-        const std::size_t i = *site.node;
-        const auto b = static_cast<std::size_t>(nodes.body[i]);
-        if (b < scene.bodies.size()) site.body = scene.bodies[b].name;
-        for (int c = 0; c < dim(); ++c) site.position[c] = nodes.position[c][i];
-    }
-    return StepFailure(describe_site(site), site);
-}
-
-void Simulation::Impl::check_step(double time_before) {
-    if (!(time > time_before)) {
-        failed = true;
-        FailureSite site{steps, time, "move", {}, {}, {0, 0, 0}, dim(), "time", {}};
-        site.cause = fmt::format("the time step {:.3g} s no longer advances the time (it is below the rounding step of "
-                                 "t = {:.6g} s); a time loop would never end",
-                                 dt_half, time);
-        throw StepFailure(describe_site(site), site);
-    }
-    // The energy guard (stop.energy_error): an unstable run gains energy it was never given.
-    const double limit = scene.stop.energy_error;
-    if (limit > 0.0 && !(std::abs(totals.energy_error) <= limit)) {
-        failed = true;
-        // The fastest node: where an instability has put the energy it made.
-        std::size_t fastest = 0;
-        double top = -1.0;
-        for (std::size_t i = 0; i < real; ++i) {
-            double v2 = 0.0;
-            for (int c = 0; c < dim(); ++c) v2 += nodes.velocity[c][i] * nodes.velocity[c][i];
-            if (!(v2 <= top)) {
-                top = v2;
-                fastest = i;
-                if (std::isnan(v2)) break;
-            }
-        }
-        FailureSite site{steps, time, "totals", fastest, {}, {0, 0, 0}, dim(), "total energy", {}};
-        if (real > 0) {
-            const auto b = static_cast<std::size_t>(nodes.body[fastest]);
-            if (b < scene.bodies.size()) site.body = scene.bodies[b].name;
-            for (int c = 0; c < dim(); ++c) site.position[c] = nodes.position[c][fastest];
-        } else {
-            site.node.reset();
-        }
-        const std::string given =
-            totals.energy_given != totals.initial_energy
-                ? fmt::format(", of {:.6g} J given with the prescribed velocities' work", totals.energy_given)
-                : std::string();
-        site.cause = fmt::format("the energy error {:+.3g} % exceeds stop.energy_error = {:.3g} % (kinetic {:.6g} J + "
-                                 "internal {:.6g} J + boundary work {:.6g} J against {:.6g} J at t = 0{}): the run is "
-                                 "unstable (a smaller solver.cfl may help); node {} is the fastest, at {:.4g} m/s",
-                                 100.0 * totals.energy_error, 100.0 * limit, totals.kinetic_energy, totals.internal_energy,
-                                 totals.boundary_work, totals.initial_energy, given, fastest, std::sqrt(std::max(top, 0.0)));
-        throw StepFailure(describe_site(site), site);
-    }
-}
 
 namespace {
 
