@@ -47,6 +47,21 @@ std::map<std::string, std::string> documented_defaults() {
     return out;
 }
 
+// The type column of each row of the page's [solver] table: "| `key` | type | ...".
+std::map<std::string, std::string> documented_solver_types() {
+    std::ifstream in(GPA_SCENE_FORMAT_DOC);
+    std::map<std::string, std::string> out;
+    std::string section, line;
+    while (std::getline(in, line)) {
+        if (line.rfind("## ", 0) == 0) section = line.substr(3);
+        if (section != "`[solver]`" || line.rfind("| `", 0) != 0) continue;
+        const auto key_end = line.find('`', 3);
+        const auto type_begin = line.find('|', key_end) + 1;
+        out[line.substr(3, key_end - 3)] = line.substr(type_begin, line.find('|', type_begin) - type_begin);
+    }
+    return out;
+}
+
 void expect_number(const std::map<std::string, std::string>& doc, const std::string& key, double value) {
     const auto it = doc.find(key);
     ASSERT_NE(it, doc.end()) << "docs/scene-format.md has no row for " << key;
@@ -93,6 +108,32 @@ TEST(SceneFormatDoc, DefaultsAreThoseOfSceneHpp) {
     // The table's solver options, 4 stop criteria, 5 output options, and no row for an option
     // that does not exist.
     EXPECT_EQ(doc.size(), solver_option_table().size() + 4u + 5u) << "rows in [solver], [stop] and [output] of docs/scene-format.md";
+}
+
+// The type column of a [solver] row says what the table's row takes: its words (each quoted, no
+// other), a time, a whole number, a boolean or a number.
+TEST(SceneFormatDoc, SolverTypesAreThoseOfTheTable) {
+    const auto types = documented_solver_types();
+    for (const SolverOption& option : solver_option_table()) {
+        const auto it = types.find(std::string(option.key));
+        ASSERT_NE(it, types.end()) << "docs/scene-format.md has no [solver] row for " << option.key;
+        const std::string& type = it->second;
+        if (const auto* choice = std::get_if<ChoiceOption>(&option.kind)) {
+            std::size_t quotes = 0;
+            for (const char c : type) quotes += c == '"';
+            EXPECT_EQ(quotes, 2 * choice->words.size()) << option.key << ": " << type;
+            for (const auto& w : choice->words) {
+                EXPECT_NE(type.find(fmt::format("`\"{}\"`", w.word)), std::string::npos) << option.key << ": " << type;
+            }
+        } else if (const auto* number = std::get_if<NumberOption>(&option.kind)) {
+            const bool time = type.find("time") != std::string::npos;
+            EXPECT_EQ(time, number->unit == OptionUnit::Time) << option.key << ": " << type;
+        } else if (std::holds_alternative<WholeNumberOption>(option.kind)) {
+            EXPECT_NE(type.find("integer"), std::string::npos) << option.key << ": " << type;
+        } else {
+            EXPECT_NE(type.find("boolean"), std::string::npos) << option.key << ": " << type;
+        }
+    }
 }
 
 }  // namespace
