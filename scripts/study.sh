@@ -29,7 +29,7 @@ plastic_variants=(
   --variant scene
   --variant scene-2t:threads=2
   --variant automatic:connectivity=automatic
-  --variant sph:weight=sph
+  --variant sph:weight=sph-nsf
   --variant bond:viscosity=bond
   --variant tension:smoothing=tension
 )
@@ -39,7 +39,7 @@ elastic_variants=(
   --variant scene
   --variant scene-2t:threads=2
   --variant fixed:connectivity=fixed
-  --variant sph:weight=sph
+  --variant sph:weight=sph-nsf
   --variant nodal:viscosity=nodal
 )
 

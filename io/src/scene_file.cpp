@@ -14,6 +14,7 @@
 
 #include "gpa/io/material_library.hpp"
 #include "material_table.hpp"
+#include "solver_reading.hpp"
 #include "toml_reading.hpp"
 
 namespace gpa::io {
@@ -37,13 +38,6 @@ const std::vector<std::string_view> body_keys{
 const std::vector<std::string_view> plane_keys{"name", "kind", "axis", "position", "side", "lift_off"};
 const std::vector<std::string_view> prescribed_keys{"name", "body", "region", "velocity", "ramp"};
 const std::vector<std::string_view> region_keys{"box", "above", "below", "beyond_radius", "within_radius"};
-const std::vector<std::string_view> solver_keys{
-    "connectivity", "switch_plastic_strain", "influence_distance", "weight",          "viscosity",
-    "normalisation", "viscosity_linear", "viscosity_quadratic", "bond_viscosity_eps0", "hourglass_coefficient", "hourglass_stiffness", "smoothing",     "smoothing_coefficient",
-    "cfl",          "alpha_limit",           "max_time_step",      "time_step_growth", "max_volume_change", "failure",
-    "separate_failed", "sliding_contact", "energy_update", "node_diameter",
-    "scatter",      "reorder_interval",      "neighbour_skin",
-};
 const std::vector<std::string_view> stop_keys{"end_time", "kinetic_energy_fraction", "max_steps", "energy_error"};
 const std::vector<std::string_view> output_keys{"snapshots", "snapshot_interval", "history_every", "checkpoint_every",
                                                 "peak_radius"};
@@ -438,59 +432,12 @@ PrescribedVelocitySpec read_prescribed_velocity(const Reporter& reporter, const 
 
 // --- options -------------------------------------------------------------------------------
 
+// Every key of the engine's table of solver options, read through the code that study variants
+// use too (solver_reading.hpp); their ranges are validate_scene's.
 SolverOptions read_solver(const Reporter& reporter, const toml::table& table) {
-    const TableReader r(reporter, table, "solver", "[solver]", solver_keys);
+    const TableReader r(reporter, table, "solver", "[solver]", solver_option_keys());
     SolverOptions s;
-    if (const auto v = r.choice<ConnectivityMode>("connectivity", connectivity_words)) s.connectivity = *v;
-    if (const auto v = r.quantity("switch_plastic_strain", D::Dimensionless)) s.switch_plastic_strain = *v;
-    if (const auto v = r.quantity("influence_distance", D::Dimensionless)) s.influence_distance = *v;
-    if (const auto v = r.choice<NodeDiameter>("node_diameter", {{"volume", NodeDiameter::Volume}, {"section", NodeDiameter::Section}, {"hoop", NodeDiameter::Hoop}})) {
-        s.node_diameter = *v;
-    }
-    if (const auto v = r.choice<WeightKind>("weight", {{"gpa", WeightKind::Gpa}, {"sph-nsf", WeightKind::SphNsf}})) {
-        s.weight = *v;
-    }
-    if (const auto v = r.choice<Normalisation>("normalisation", {{"per-direction", Normalisation::PerDirection},
-                                                                 {"moment-matrix", Normalisation::MomentMatrix}})) {
-        s.normalisation = *v;
-    }
-    if (const auto v = r.choice<ViscosityKind>(
-            "viscosity", {{"none", ViscosityKind::None}, {"nodal", ViscosityKind::Nodal}, {"bond", ViscosityKind::Bond}})) {
-        s.viscosity = *v;
-    }
-    if (const auto v = r.quantity("viscosity_linear", D::Dimensionless)) s.viscosity_linear = *v;
-    if (const auto v = r.quantity("viscosity_quadratic", D::Dimensionless)) s.viscosity_quadratic = *v;
-    if (const auto v = r.quantity("bond_viscosity_eps0", D::Dimensionless)) s.bond_viscosity_eps0 = *v;
-    if (const auto v = r.quantity("hourglass_coefficient", D::Dimensionless)) s.hourglass_coefficient = *v;
-    if (const auto v = r.quantity("hourglass_stiffness", D::Dimensionless)) s.hourglass_stiffness = *v;
-    if (const auto v = r.choice<SmoothingMode>("smoothing", {{"off", SmoothingMode::Off},
-                                                             {"everywhere", SmoothingMode::Everywhere},
-                                                             {"tension", SmoothingMode::Tension}})) {
-        s.smoothing = *v;
-    }
-    if (const auto v = r.quantity("smoothing_coefficient", D::Dimensionless)) s.smoothing_coefficient = *v;
-    if (const auto v = r.quantity("cfl", D::Dimensionless)) s.cfl = *v;
-    if (const auto v = r.quantity("alpha_limit", D::Dimensionless)) s.alpha_limit = *v;
-    if (const auto v = r.quantity("neighbour_skin", D::Dimensionless)) s.neighbour_skin = *v;
-    if (const auto v = r.quantity("max_time_step", D::Time, Limit::PositiveOrInfinite)) s.max_time_step = *v;
-    if (const auto v = r.quantity("time_step_growth", D::Dimensionless)) s.time_step_growth = *v;
-    if (const auto v = r.quantity("max_volume_change", D::Dimensionless)) s.max_volume_change = *v;
-    if (const auto v = r.boolean("failure")) s.failure = *v;
-    if (const auto v = r.boolean("separate_failed")) s.separate_failed = *v;
-    if (const auto v = r.boolean("sliding_contact")) s.sliding_contact = *v;
-    if (const auto v = r.choice<EnergyUpdate>("energy_update", {{"compatible", EnergyUpdate::Compatible},
-                                                                {"point", EnergyUpdate::Point}})) {
-        s.energy_update = *v;
-    }
-    if (const auto v = r.choice<ScatterScheme>("scatter", {{"slabs", ScatterScheme::Slabs},
-                                                           {"cells", ScatterScheme::Cells},
-                                                           {"graph", ScatterScheme::Graph},
-                                                           {"serial", ScatterScheme::Serial}})) {
-        s.scatter = *v;
-    }
-    if (const auto v = r.whole_number("reorder_interval", 0, std::numeric_limits<long long>::max())) {
-        s.reorder_interval = static_cast<std::size_t>(*v);
-    }
+    for (const SolverOption& option : solver_option_table()) read_solver_option(r, option, s);
     return s;
 }
 

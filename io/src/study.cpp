@@ -8,15 +8,18 @@
 #include <optional>
 #include <set>
 #include <stdexcept>
+#include <type_traits>
+#include <variant>
 
 #include <fmt/format.h>
 
 #include "gpa/engine/bodies.hpp"
 #include "gpa/engine/elements.hpp"
 #include "gpa/engine/errors.hpp"
+#include "gpa/engine/solver_options.hpp"
 #include "gpa/io/output.hpp"
 #include "gpa/io/svg_plot.hpp"
-#include "gpa/io/units.hpp"
+#include "solver_reading.hpp"
 
 namespace gpa::io {
 
@@ -77,42 +80,37 @@ std::optional<long> to_long(const std::string& s) {
 
 // --- variant keys --------------------------------------------------------------------------
 
-struct ChoiceKey {
-    const char* key;
-    std::vector<const char*> words;  // accepted values (the scene file's words first)
-};
+// A variant sets the keys of the engine's table of solver options (solver_options.hpp), with the
+// scene file's words, units and ranges, plus two keys of its own.
 
-const std::vector<ChoiceKey> choice_keys{
-    {"connectivity", {"fixed", "variable", "automatic"}},
-    {"weight", {"gpa", "sph", "sph-nsf"}},
-    {"normalisation", {"per-direction", "moment-matrix"}},
-    {"viscosity", {"none", "nodal", "bond"}},
-    {"smoothing", {"off", "tension", "everywhere"}},
-    {"discretisation", {"particles", "elements"}},
-    {"node_diameter", {"volume", "section", "hoop"}},
-};
-
-const std::vector<const char*> number_keys{
-    "cfl", "influence_distance", "switch_plastic_strain", "viscosity_linear", "viscosity_quadratic",
-    "bond_viscosity_eps0", "hourglass_coefficient", "hourglass_stiffness", "smoothing_coefficient", "alpha_limit",
-};
-
-const ChoiceKey* find_choice_key(std::string_view key) {
-    for (const auto& c : choice_keys) {
-        if (key == c.key) return &c;
-    }
-    return nullptr;
-}
-
-bool is_number_key(std::string_view key) {
-    return std::any_of(number_keys.begin(), number_keys.end(), [&](const char* k) { return key == k; });
-}
+// discretisation: every body's discretisation (not a solver option).
+const std::vector<std::pair<std::string_view, Discretisation>> discretisation_words{
+    {"particles", Discretisation::Particles}, {"elements", Discretisation::Elements}};
 
 std::string allowed_keys() {
     std::string s;
-    for (const auto& c : choice_keys) s += std::string(s.empty() ? "" : ", ") + c.key;
-    for (const char* k : number_keys) s += std::string(", ") + k;
-    return s + ", threads";
+    for (const auto& option : solver_option_table()) s += fmt::format("{}{}", s.empty() ? "" : ", ", option.key);
+    return s + ", discretisation, threads";
+}
+
+// A row's values for the help text: "fixed|variable|automatic", "NUMBER", "TIME", "true|false", "N".
+std::string values_help(const SolverOption& option) {
+    return std::visit(
+        [](const auto& k) -> std::string {
+            using K = std::decay_t<decltype(k)>;
+            if constexpr (std::is_same_v<K, NumberOption>) {
+                return k.unit == OptionUnit::Time ? "TIME" : "NUMBER";
+            } else if constexpr (std::is_same_v<K, WholeNumberOption>) {
+                return "N";
+            } else if constexpr (std::is_same_v<K, BooleanOption>) {
+                return "true|false";
+            } else {
+                std::string words;
+                for (const auto& w : k.words) words += fmt::format("{}{}", words.empty() ? "" : "|", w.word);
+                return words;
+            }
+        },
+        option.kind);
 }
 
 // --- formatting ----------------------------------------------------------------------------
@@ -346,17 +344,16 @@ Variant parse_variant(std::string_view text) {
         if (eq == std::string::npos) throw fail(fmt::format("'{}' is not key=value; keys: {}", item, allowed_keys()));
         const std::string key = trim(std::string_view(item).substr(0, eq)), value = trim(std::string_view(item).substr(eq + 1));
         if (!seen.insert(key).second) throw fail(fmt::format("{} is set twice", key));
-        if (const auto* c = find_choice_key(key)) {
-            if (std::none_of(c->words.begin(), c->words.end(), [&](const char* w) { return value == w; })) {
-                std::string words;
-                for (const char* w : c->words) words += std::string(words.empty() ? "" : ", ") + w;
-                throw fail(fmt::format("{} must be one of {}, not '{}'", key, words, value));
-            }
-        } else if (is_number_key(key)) {
-            try {
-                parse_quantity(value, Dimension::Dimensionless);
-            } catch (const UnitError&) {
-                throw fail(fmt::format("{} must be a number, not '{}'", key, value));
+        if (const auto* option = find_solver_option(key)) {
+            // Read as a scene file reads the same value, then range-checked as validate_scene
+            // does, so that a bad value fails before anything runs.
+            SolverOptions scratch;
+            detail::read_solver_option_text(*option, value, fmt::format("--variant '{}'", text), scratch);
+            if (const auto message = option_error(*option, scratch)) throw fail(*message);
+        } else if (key == "discretisation") {
+            if (std::none_of(discretisation_words.begin(), discretisation_words.end(),
+                             [&](const auto& w) { return value == w.first; })) {
+                throw fail(fmt::format("discretisation must be one of particles, elements, not '{}'", value));
             }
         } else if (key == "threads") {
             const auto n = to_long(value);
@@ -364,6 +361,10 @@ Variant parse_variant(std::string_view text) {
             v.threads = static_cast<int>(*n);
             continue;
         } else {
+            // A near miss of a key is named, as the scene reader does.
+            std::vector<std::string_view> keys = solver_option_keys();
+            keys.insert(keys.end(), {"discretisation", "threads"});
+            if (const auto near = detail::closest(key, keys)) throw fail(fmt::format("unknown key '{}'; did you mean '{}'?", key, *near));
             throw fail(fmt::format("unknown key '{}'; keys: {}", key, allowed_keys()));
         }
         v.settings.emplace_back(key, value);
@@ -373,56 +374,38 @@ Variant parse_variant(std::string_view text) {
 
 std::string variant_keys_help() {
     std::string s;
-    for (const auto& c : choice_keys) {
-        std::string words;
-        for (const char* w : c.words) words += std::string(words.empty() ? "" : "|") + w;
-        s += fmt::format("{}{}={}", s.empty() ? "" : ", ", c.key, words);
+    for (const auto& option : solver_option_table()) {
+        s += fmt::format("{}{}={}", s.empty() ? "" : ", ", option.key, values_help(option));
     }
-    for (const char* k : number_keys) s += fmt::format(", {}=NUMBER", k);
-    return s + ", threads=N";
+    return s + ", discretisation=particles|elements, threads=N";
 }
 
 void apply_variant(const Variant& variant, Scene& scene) {
-    auto& o = scene.solver;
     for (const auto& [key, value] : variant.settings) {
-        if (key == "connectivity") {
-            o.connectivity = value == "fixed"      ? ConnectivityMode::Fixed
-                             : value == "variable" ? ConnectivityMode::Variable
-                                                   : ConnectivityMode::Automatic;
-            for (auto& b : scene.bodies) b.connectivity.reset();
-        } else if (key == "weight") {
-            o.weight = value == "gpa" ? WeightKind::Gpa : WeightKind::SphNsf;
-        } else if (key == "normalisation") {
-            o.normalisation = value == "per-direction" ? Normalisation::PerDirection : Normalisation::MomentMatrix;
-        } else if (key == "viscosity") {
-            o.viscosity = value == "none" ? ViscosityKind::None : value == "nodal" ? ViscosityKind::Nodal : ViscosityKind::Bond;
-        } else if (key == "smoothing") {
-            o.smoothing = value == "off" ? SmoothingMode::Off : value == "tension" ? SmoothingMode::Tension : SmoothingMode::Everywhere;
-        } else if (key == "node_diameter") {
-            o.node_diameter = value == "section" ? NodeDiameter::Section : value == "hoop" ? NodeDiameter::Hoop : NodeDiameter::Volume;
+        if (const auto* option = find_solver_option(key)) {
+            detail::read_solver_option_text(*option, value, fmt::format("--variant {}", variant.name), scene.solver);
+            // The variant's connectivity holds for every body.
+            if (key == "connectivity") {
+                for (auto& b : scene.bodies) b.connectivity.reset();
+            }
         } else if (key == "discretisation") {
             // Every body, meshed from the same shape at the same spacing; the particle-only body
             // keys go, since they do not apply to element bodies.
+            const auto d = std::find_if(discretisation_words.begin(), discretisation_words.end(),
+                                        [&](const auto& w) { return value == w.first; });
+            if (d == discretisation_words.end()) {
+                throw InputError(fmt::format("--variant {}: discretisation must be one of particles, elements, not '{}'",
+                                             variant.name, value));
+            }
             for (auto& b : scene.bodies) {
-                b.discretisation = value == "elements" ? Discretisation::Elements : Discretisation::Particles;
+                b.discretisation = d->second;
                 if (b.discretisation == Discretisation::Elements) {
                     b.connectivity.reset();
                     b.lattice_neighbours = 0;
                 }
             }
         } else {
-            const double x = parse_quantity(value, Dimension::Dimensionless);
-            if (key == "cfl") o.cfl = x;
-            else if (key == "influence_distance") o.influence_distance = x;
-            else if (key == "switch_plastic_strain") o.switch_plastic_strain = x;
-            else if (key == "viscosity_linear") o.viscosity_linear = x;
-            else if (key == "viscosity_quadratic") o.viscosity_quadratic = x;
-            else if (key == "bond_viscosity_eps0") o.bond_viscosity_eps0 = x;
-            else if (key == "hourglass_coefficient") o.hourglass_coefficient = x;
-            else if (key == "hourglass_stiffness") o.hourglass_stiffness = x;
-            else if (key == "smoothing_coefficient") o.smoothing_coefficient = x;
-            else if (key == "alpha_limit") o.alpha_limit = x;
-            else throw InputError(fmt::format("--variant {}: unknown key '{}'", variant.name, key));
+            throw InputError(fmt::format("--variant {}: unknown key '{}'", variant.name, key));
         }
     }
     try {

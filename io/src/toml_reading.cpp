@@ -474,6 +474,15 @@ std::optional<std::vector<double>> TableReader::quantities(std::string_view key,
     return values;
 }
 
+std::optional<std::size_t> TableReader::word_index(std::string_view key, const std::vector<std::string_view>& words) const {
+    const auto word = string(key);
+    if (!word) return std::nullopt;
+    for (std::size_t i = 0; i < words.size(); ++i) {
+        if (*word == words[i]) return i;
+    }
+    fail_choice(key, *word, words);
+}
+
 void TableReader::fail_choice(std::string_view key, std::string_view word,
                               const std::vector<std::string_view>& names) const {
     std::string message = fmt::format("{} is not one of {}", in_quotes(word), join_quoted(names));

@@ -111,6 +111,10 @@ public:
         fail_choice(key, *word, names);
     }
 
+    // The index in `words` of the key's word, for lists built at run time (the solver option
+    // table's choices); fails like choice() for a word that is not listed.
+    std::optional<std::size_t> word_index(std::string_view key, const std::vector<std::string_view>& words) const;
+
 private:
     [[noreturn]] void fail_choice(std::string_view key, std::string_view word,
                                   const std::vector<std::string_view>& names) const;

@@ -73,7 +73,7 @@ grep -qE 'first time step [1-9][0-9.]* ns' out.txt || fail "check prints no posi
 
 # 6. gpa study: a small elastic bar over three resolutions, two variants and two thread counts.
 bar="$src/tests/cli/study-bar.toml"
-expect 0 "study" -- "$gpa" study "$bar" -o study --refine 1,1.5,2 --threads 1,2 --variant scene --variant sph:weight=sph -q
+expect 0 "study" -- "$gpa" study "$bar" -o study --refine 1,1.5,2 --threads 1,2 --variant scene --variant sph:weight=sph-nsf -q
 for f in study.csv study.md error_vs_time.svg discretisation_error_vs_time.svg; do
   [[ -s "study/$f" ]] || fail "study output lacks $f"
 done
@@ -139,13 +139,13 @@ study_refused "refine not a number" "--refine '1,x'" --refine 1,x
 study_refused "refine twice" "listed twice" --refine 1,2,1
 study_refused "refine zero" "positive refinement factor" --refine 0,1
 study_refused "threads" "--threads" --threads 1,-1
-study_refused "reference from two series" "--reference" --refine 1,1.5,2 --variant a --variant b:weight=sph --reference r.toml
+study_refused "reference from two series" "--reference" --refine 1,1.5,2 --variant a --variant b:weight=sph-nsf --reference r.toml
 study_refused "reference from two resolutions" "--reference" --refine 1,2 --reference r.toml
 study_refused "unknown variant key" "unknown key 'colour'" --variant x:colour=red
-study_refused "bad variant value" "weight must be one of gpa, sph, sph-nsf" --variant x:weight=foo
-study_refused "variant without a name" "name before its settings" --variant weight=sph
-study_refused "variant name twice" "given twice" --variant a --variant a:weight=sph
-study_refused "variant out of range" "--variant fast" --variant fast:cfl=2
+study_refused "bad variant value" 'solver.weight: "foo" is not one of "gpa" or "sph-nsf"' --variant x:weight=foo
+study_refused "variant without a name" "name before its settings" --variant weight=sph-nsf
+study_refused "variant name twice" "given twice" --variant a --variant a:weight=sph-nsf
+study_refused "variant out of range" "--variant 'fast:cfl=2': solver.cfl = 2 is outside (0, 1]" --variant fast:cfl=2
 study_refused "refinements on one lattice" "give the same lattice" --refine 1,1.01,2
 expect 2 "study of a missing scene" -- "$gpa" study "$work/no-such-scene.toml" -o refused -q
 [[ -e refused || -e refused.partial ]] && fail "study of a missing scene left an output folder"

@@ -1,6 +1,6 @@
-// docs/scene-format.md documents every option of SolverOptions, StopCriteria and OutputOptions
-// with the default that scene.hpp gives it. When a default changes in the code, this test says
-// which line of the documentation to change.
+// docs/scene-format.md documents every option of SolverOptions (every row of the table of solver
+// options), StopCriteria and OutputOptions with the default that scene.hpp gives it. When a
+// default changes in the code, this test says which line of the documentation to change.
 
 #include <cmath>
 #include <cstdlib>
@@ -8,12 +8,14 @@
 #include <limits>
 #include <map>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include "gpa/engine/scene.hpp"
+#include "gpa/engine/solver_options.hpp"
 
 namespace gpa {
 namespace {
@@ -45,27 +47,19 @@ std::map<std::string, std::string> documented_defaults() {
     return out;
 }
 
-std::string word(ConnectivityMode c) {
-    return c == ConnectivityMode::Fixed ? "\"fixed\"" : c == ConnectivityMode::Variable ? "\"variable\"" : "\"automatic\"";
-}
-std::string word(ViscosityKind v) {
-    return v == ViscosityKind::None ? "\"none\"" : v == ViscosityKind::Nodal ? "\"nodal\"" : "\"bond\"";
-}
-std::string word(SmoothingMode s) {
-    return s == SmoothingMode::Off ? "\"off\"" : s == SmoothingMode::Everywhere ? "\"everywhere\"" : "\"tension\"";
-}
-std::string word(WeightKind w) { return w == WeightKind::Gpa ? "\"gpa\"" : "\"sph-nsf\""; }
-std::string word(Normalisation n) {
-    return n == Normalisation::PerDirection ? "\"per-direction\"" : "\"moment-matrix\"";
-}
-std::string word(ScatterScheme s) {
-    switch (s) {
-        case ScatterScheme::Slabs: return "\"slabs\"";
-        case ScatterScheme::Cells: return "\"cells\"";
-        case ScatterScheme::Graph: return "\"graph\"";
-        case ScatterScheme::Serial: return "\"serial\"";
+// The type column of each row of the page's [solver] table: "| `key` | type | ...".
+std::map<std::string, std::string> documented_solver_types() {
+    std::ifstream in(GPA_SCENE_FORMAT_DOC);
+    std::map<std::string, std::string> out;
+    std::string section, line;
+    while (std::getline(in, line)) {
+        if (line.rfind("## ", 0) == 0) section = line.substr(3);
+        if (section != "`[solver]`" || line.rfind("| `", 0) != 0) continue;
+        const auto key_end = line.find('`', 3);
+        const auto type_begin = line.find('|', key_end) + 1;
+        out[line.substr(3, key_end - 3)] = line.substr(type_begin, line.find('|', type_begin) - type_begin);
     }
-    return "?";
+    return out;
 }
 
 void expect_number(const std::map<std::string, std::string>& doc, const std::string& key, double value) {
@@ -83,34 +77,16 @@ void expect_word(const std::map<std::string, std::string>& doc, const std::strin
 
 TEST(SceneFormatDoc, DefaultsAreThoseOfSceneHpp) {
     const auto doc = documented_defaults();
-    const SolverOptions s;
-    expect_word(doc, "connectivity", word(s.connectivity));
-    expect_number(doc, "switch_plastic_strain", s.switch_plastic_strain);
-    expect_number(doc, "influence_distance", s.influence_distance);
-    expect_word(doc, "node_diameter", s.node_diameter == NodeDiameter::Hoop     ? "\"hoop\""
-                                      : s.node_diameter == NodeDiameter::Volume ? "\"volume\""
-                                                                                : "\"section\"");
-    expect_word(doc, "weight", word(s.weight));
-    expect_word(doc, "normalisation", word(s.normalisation));
-    expect_word(doc, "viscosity", word(s.viscosity));
-    expect_number(doc, "viscosity_linear", s.viscosity_linear);
-    expect_number(doc, "viscosity_quadratic", s.viscosity_quadratic);
-    expect_number(doc, "bond_viscosity_eps0", s.bond_viscosity_eps0);
-    expect_word(doc, "smoothing", word(s.smoothing));
-    expect_number(doc, "hourglass_coefficient", s.hourglass_coefficient);
-    expect_number(doc, "hourglass_stiffness", s.hourglass_stiffness);
-    expect_number(doc, "smoothing_coefficient", s.smoothing_coefficient);
-    expect_number(doc, "cfl", s.cfl);
-    expect_number(doc, "alpha_limit", s.alpha_limit);
-    expect_number(doc, "max_time_step", s.max_time_step);
-    expect_number(doc, "time_step_growth", s.time_step_growth);
-    expect_word(doc, "failure", s.failure ? "true" : "false");
-    expect_word(doc, "separate_failed", s.separate_failed ? "true" : "false");
-    expect_word(doc, "sliding_contact", s.sliding_contact ? "true" : "false");
-    expect_word(doc, "energy_update", s.energy_update == EnergyUpdate::Compatible ? "\"compatible\"" : "\"point\"");
-    expect_word(doc, "scatter", word(s.scatter));
-    expect_number(doc, "reorder_interval", static_cast<double>(s.reorder_interval));
-    expect_number(doc, "neighbour_skin", s.neighbour_skin);
+    // [solver]: every row of the table of solver options, its default as the table prints it
+    // (numbers compared as numbers, so that 1.0 and 1 agree; a time's unit left off).
+    for (const SolverOption& option : solver_option_table()) {
+        const std::string value = option_default_text(option);
+        if (std::holds_alternative<NumberOption>(option.kind) || std::holds_alternative<WholeNumberOption>(option.kind)) {
+            expect_number(doc, std::string(option.key), std::strtod(value.c_str(), nullptr));
+        } else {
+            expect_word(doc, std::string(option.key), value);
+        }
+    }
 
     const StopCriteria stop;
     expect_number(doc, "end_time", stop.end_time);
@@ -129,9 +105,35 @@ TEST(SceneFormatDoc, DefaultsAreThoseOfSceneHpp) {
     EXPECT_EQ(o.peak_radius, 0.0);
     expect_word(doc, "peak_radius", " twice the first body's spacing as written ");  // a cell without a `value`: as written
 
-    // 24 solver options, 4 stop criteria, 5 output options, and no row for an option that does
-    // not exist.
-    EXPECT_EQ(doc.size(), 35u) << "rows in [solver], [stop] and [output] of docs/scene-format.md";
+    // The table's solver options, 4 stop criteria, 5 output options, and no row for an option
+    // that does not exist.
+    EXPECT_EQ(doc.size(), solver_option_table().size() + 4u + 5u) << "rows in [solver], [stop] and [output] of docs/scene-format.md";
+}
+
+// The type column of a [solver] row says what the table's row takes: its words (each quoted, no
+// other), a time, a whole number, a boolean or a number.
+TEST(SceneFormatDoc, SolverTypesAreThoseOfTheTable) {
+    const auto types = documented_solver_types();
+    for (const SolverOption& option : solver_option_table()) {
+        const auto it = types.find(std::string(option.key));
+        ASSERT_NE(it, types.end()) << "docs/scene-format.md has no [solver] row for " << option.key;
+        const std::string& type = it->second;
+        if (const auto* choice = std::get_if<ChoiceOption>(&option.kind)) {
+            std::size_t quotes = 0;
+            for (const char c : type) quotes += c == '"';
+            EXPECT_EQ(quotes, 2 * choice->words.size()) << option.key << ": " << type;
+            for (const auto& w : choice->words) {
+                EXPECT_NE(type.find(fmt::format("`\"{}\"`", w.word)), std::string::npos) << option.key << ": " << type;
+            }
+        } else if (const auto* number = std::get_if<NumberOption>(&option.kind)) {
+            const bool time = type.find("time") != std::string::npos;
+            EXPECT_EQ(time, number->unit == OptionUnit::Time) << option.key << ": " << type;
+        } else if (std::holds_alternative<WholeNumberOption>(option.kind)) {
+            EXPECT_NE(type.find("integer"), std::string::npos) << option.key << ": " << type;
+        } else {
+            EXPECT_NE(type.find("boolean"), std::string::npos) << option.key << ": " << type;
+        }
+    }
 }
 
 }  // namespace

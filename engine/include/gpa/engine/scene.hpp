@@ -199,6 +199,9 @@ struct SolverOptions {
     // For tests: after every step's cut of the candidates, search all pairs afresh and throw
     // NumericalError if the lists differ as sets (slow; not read from scene files).
     bool check_neighbour_lists = false;
+
+    // Member by member, for tests that a scene file and a study variant give the same options.
+    bool operator==(const SolverOptions&) const = default;
 };
 
 struct StopCriteria {
