@@ -37,7 +37,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr const char* checkpoint_name = "checkpoint.gpack";
+constexpr const char* checkpoint_name = io::checkpoint_file_name;
 constexpr const char* scene_copy_name = "scene.toml";
 
 // The scene's text and what messages call it.

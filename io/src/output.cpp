@@ -47,6 +47,13 @@ RunFolder::RunFolder(fs::path folder, bool overwrite, Mode mode) : final_(std::m
                                           final_.string()));
         }
     }
+    // A stopped run that can still be resumed is work the user may want back: it is discarded
+    // only on request, and checked before anything else touches the folder.
+    if (!overwrite_ && fs::exists(partial_ / checkpoint_file_name, ec)) {
+        throw OutputError(fmt::format("'{}' holds a stopped run that can be resumed (it has a checkpoint); continue it with "
+                                      "gpa run --resume {}, or pass --overwrite to discard it and start again",
+                                      partial_.string(), final_.string()));
+    }
     fs::remove_all(partial_, ec);
     if (ec) throw OutputError(fmt::format("cannot clear '{}': {}", partial_.string(), ec.message()));
     fs::create_directories(partial_, ec);

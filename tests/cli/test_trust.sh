@@ -196,6 +196,23 @@ kill -INT $pid; wait $pid
 expect 2 "resume with another scene" -- "$gpa" run --resume other "$tiny" -q
 says err.txt "is not the scene the run in" "resume with another scene"
 expect 2 "resume with -o" -- "$gpa" run --resume other -o elsewhere -q
+# A new run on the folder of a stopped run that can be resumed is refused, naming --resume and
+# --overwrite, and the stopped run is left as it was (issue 21, item 1); also when the new run
+# would have been refused anyway (here: more disk than there is), which once deleted it first.
+listing() { (cd "$1" && find . -type f | sort | xargs md5sum); }
+listing other.partial > other.before
+expect 2 "new run over a resumable run" -- "$gpa" run long.toml -o other -q
+says err.txt "gpa run --resume other" "new run over a resumable run"
+says err.txt "--overwrite" "new run over a resumable run"
+listing other.partial | cmp -s - other.before || fail "a refused new run changed other.partial"
+variant huge.toml -e 's/^max_steps = 20/end_time = "1 s"/' -e 's/^snapshots = 3/snapshot_interval = "1 ns"/'
+expect 2 "a run needing too much disk over a resumable run" -- "$gpa" run huge.toml -o other -q
+says err.txt "gpa run --resume other" "a run needing too much disk over a resumable run"
+listing other.partial | cmp -s - other.before || fail "a run refused for its disk estimate changed other.partial"
+cp -a other.partial replaced.partial
+expect 0 "--overwrite replaces a resumable run" -- "$gpa" run "$tiny" -o replaced -q --overwrite
+[[ -e replaced.partial ]] && fail "--overwrite left replaced.partial"
+grep -q '"scene": "tiny"' replaced/summary.json 2> /dev/null || fail "--overwrite: the new run's summary: $(head -c 300 replaced/summary.json)"
 expect 0 "resume with its own scene named" -- "$gpa" run --resume other long.toml -q
 
 # --- a full disk -----------------------------------------------------------------------------

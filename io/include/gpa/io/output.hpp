@@ -20,10 +20,17 @@
 
 namespace gpa::io {
 
+// The checkpoint a stopped run leaves in its folder.partial: while it is there, the run can be
+// resumed (gpa run --resume).
+inline constexpr const char* checkpoint_file_name = "checkpoint.gpack";
+
 class RunFolder {
 public:
     // Fresh: refuses an existing, non-empty `folder` unless overwrite is set (OutputError naming
     // it); clears a stale `folder.partial` left by an earlier failed run and creates a fresh one.
+    // A `folder.partial` that holds a checkpoint (a run that can be resumed) is cleared only
+    // when overwrite is set; otherwise OutputError naming --resume and --overwrite, and the
+    // folder is left as it is.
     // Resume: `folder` (or `folder.partial`) names a run that was stopped; its folder.partial
     // must exist and is kept as it is.
     // Either way the folder's lock (folder.lock, FolderLock) is taken first and held until the
