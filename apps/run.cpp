@@ -6,6 +6,7 @@
 #include <csignal>
 #include <ctime>
 #include <exception>
+#include <fstream>
 #include <future>
 #include <limits>
 #include <sstream>
@@ -137,6 +138,7 @@ struct RunState {
     double wall_seconds = 0.0, output_seconds = 0.0;
     double snapshot_slot = 0.0;
     std::vector<io::PvdEntry> snapshots;  // the scheduled ones, in order
+    io::HistoryWriter::Mark history;      // history.csv as it was (not recorded by older checkpoints)
 };
 
 std::string encode(const RunState& s) {
@@ -146,6 +148,7 @@ std::string encode(const RunState& s) {
     out += fmt::format("scene_file={}\noverwrite={}\nwall_seconds={:.17g}\noutput_seconds={:.17g}\nsnapshot_slot={:.17g}\n",
                        scene, s.overwrite ? 1 : 0, s.wall_seconds, s.output_seconds, s.snapshot_slot);
     for (const auto& e : s.snapshots) out += fmt::format("snapshot={:.17g} {} {}\n", e.time, e.part, e.file);
+    out += fmt::format("history={} {:016x}\n", s.history.bytes, s.history.digest);
     return out;
 }
 
@@ -166,6 +169,13 @@ RunState decode(const std::string& text, const std::string& source) {
             else if (key == "wall_seconds") s.wall_seconds = std::stod(value);
             else if (key == "output_seconds") s.output_seconds = std::stod(value);
             else if (key == "snapshot_slot") s.snapshot_slot = std::stod(value);
+            else if (key == "history") {
+                const auto space = value.find(' ');
+                if (space == std::string::npos) throw std::invalid_argument(value);
+                s.history.bytes = std::stoll(value.substr(0, space));
+                s.history.digest = std::stoull(value.substr(space + 1), nullptr, 16);
+                if (s.history.bytes <= 0) throw std::invalid_argument(value);
+            }
             else if (key == "snapshot") {
                 const auto space = value.find(' ');
                 const auto second = space == std::string::npos ? space : value.find(' ', space + 1);
@@ -179,6 +189,19 @@ RunState decode(const std::string& text, const std::string& source) {
         }
     }
     return s;
+}
+
+// Whether a snapshot file ends with the tag that closes it (</VTKFile>, and a line end).
+bool ends_with_closing_tag(const fs::path& file) {
+    std::ifstream in(file, std::ios::binary);
+    const std::string tag = "</VTKFile>";
+    if (!in.seekg(0, std::ios::end)) return false;
+    const auto size = static_cast<long long>(in.tellg());
+    const long long tail = std::min<long long>(size, 64);
+    std::string end(static_cast<std::size_t>(tail), '\0');
+    if (!in.seekg(size - tail) || !in.read(end.data(), tail)) return false;
+    while (!end.empty() && (end.back() == '\n' || end.back() == '\r' || end.back() == ' ')) end.pop_back();
+    return end.size() >= tag.size() && end.compare(end.size() - tag.size(), tag.size(), tag) == 0;
 }
 
 std::uint64_t free_bytes(const fs::path& folder) {
@@ -306,13 +329,27 @@ public:
         check_disk(sim_, schedule_, folder_.partial(), file_bytes(folder_.partial() / snapshots_.series().entries()[0].file));
     }
 
-    // A resumed run: its outputs cut back to what they were at the checkpoint.
+    // A resumed run: its outputs checked and cut back to what they were at the checkpoint.
+    // Whatever cannot be continued is refused before anything in the folder changes.
     void resume(std::size_t checkpoint_step) {
         const Scene& scene = sim_.scene();
         const std::size_t every = std::max<std::size_t>(scene.output.history_every, 1);
+        const std::string checkpoint = (folder_.partial() / checkpoint_name).string();
+        // Every snapshot the checkpoint lists must be there and whole (a writer's file ends with
+        // its closing tag); the .pvd rewritten below lists them all.
+        for (const auto& e : state_.snapshots) {
+            const fs::path file = folder_.partial() / e.file;
+            std::error_code ec;
+            const bool present = fs::is_regular_file(file, ec);
+            if (!present || !ends_with_closing_tag(file)) {
+                throw io::OutputError(fmt::format("'{}' {} (the snapshot of t = {:.6g} us that '{}' lists): the stopped run cannot "
+                                                  "be continued from it (gpa run --overwrite starts it again)",
+                                                  file.string(), present ? "is not whole" : "is missing", e.time * 1e6, checkpoint));
+            }
+        }
         sim_.measure_bodies();
-        history_.emplace(folder_.partial() / "history.csv", sim_.totals(), dimension_of(scene.geometry),
-                         [&](std::size_t step) { return step <= checkpoint_step && step % every == 0; });
+        history_.emplace(folder_.partial() / "history.csv", sim_.totals(), dimension_of(scene.geometry), checkpoint_step, every,
+                         state_.history, checkpoint);
         last_row_ = checkpoint_step;
         schedule_.set_last_slot(state_.snapshot_slot);
         snapshots_.add_seconds(state_.output_seconds);
@@ -395,6 +432,7 @@ private:
         s.wall_seconds = wall_seconds;
         s.output_seconds = snapshots_.seconds();
         s.snapshot_slot = schedule_.last_slot();
+        s.history = history_->mark();
         s.snapshots.clear();
         for (const auto& e : snapshots_.series().entries()) {
             if (e.name.empty()) s.snapshots.push_back(e);
@@ -545,6 +583,12 @@ int resumed_run(const RunOptions& options) {
     SceneSource source = options.scene ? read_source(options.scene) : SceneSource{io::read_scene_text(copy), copy.string(), copy.string()};
     const CheckpointInfo info = io::checkpoint_info(checkpoint);
     if (info.scene_fingerprint != io::scene_fingerprint(source.text)) {
+        if (!options.scene) {
+            // The folder's own copy: the two files came from different runs.
+            throw CheckpointError(fmt::format("'{}' and '{}' are not of the same run (the checkpoint was written for another scene): "
+                                              "the stopped run cannot be continued from them (gpa run --overwrite starts it again)",
+                                              checkpoint.string(), copy.string()));
+        }
         throw CheckpointError(fmt::format("'{}' is not the scene the run in '{}' started with (its copy is '{}')", source.name,
                                           folder.partial().string(), copy.string()));
     }

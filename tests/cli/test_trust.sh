@@ -215,6 +215,42 @@ expect 0 "--overwrite replaces a resumable run" -- "$gpa" run "$tiny" -o replace
 grep -q '"scene": "tiny"' replaced/summary.json 2> /dev/null || fail "--overwrite: the new run's summary: $(head -c 300 replaced/summary.json)"
 expect 0 "resume with its own scene named" -- "$gpa" run --resume other long.toml -q
 
+# Resume checks what it keeps (issue 21, item 2), each on a copy of one stopped run; a refusal
+# names the file and leaves the folder as it was. (Rows written after the checkpoint are cut back:
+# the kill -9 resumes above.)
+variant slower.toml -e 's/^max_steps = 20/max_steps = 4000/' -e 's/^snapshots = 3/snapshot_interval = "5 us"/' -e 's/"-50 m\/s"/"-40 m\/s"/'
+for scene in long slower; do
+  "$gpa" run $scene.toml -o stopped-$scene -q > /dev/null 2>&1 &
+  pid=$!
+  wait_for_lines stopped-$scene.partial/history.csv 30 || fail "stopped-$scene: the run never got going"
+  kill -INT $pid; wait $pid
+done
+refused_resume() {
+  local dir=$1 what=$2; shift 2
+  listing "$dir.partial" > "$dir.before"
+  expect 2 "$what" -- "$gpa" run --resume "$dir" -q
+  for fragment in "$@"; do says err.txt "$fragment" "$what"; done
+  listing "$dir.partial" | cmp -s - "$dir.before" || fail "$what: the refusal changed $dir.partial"
+  [[ -e $dir ]] && fail "$what: the refused resume made $dir"
+}
+cp -a stopped-long.partial cut.partial
+head -n 10 stopped-long.partial/history.csv > cut.partial/history.csv
+refused_resume cut "history cut before the checkpoint" "'cut.partial/history.csv' has been cut short"
+cp -a stopped-long.partial gone.partial
+rm gone.partial/particles_00000.vtp
+refused_resume gone "a listed snapshot deleted" "'gone.partial/particles_00000.vtp' is missing"
+cp -a stopped-long.partial torn.partial
+head -c 2000 stopped-long.partial/particles_00000.vtp > torn.partial/particles_00000.vtp
+refused_resume torn "a listed snapshot cut short" "'torn.partial/particles_00000.vtp' is not whole"
+cp -a stopped-long.partial mixed.partial
+cp stopped-slower.partial/scene.toml mixed.partial/
+refused_resume mixed "scene.toml of another run" "'mixed.partial/checkpoint.gpack' and 'mixed.partial/scene.toml' are not of the same run"
+cp -a stopped-long.partial swapped.partial
+cp stopped-slower.partial/scene.toml stopped-slower.partial/checkpoint.gpack swapped.partial/
+refused_resume swapped "checkpoint and scene.toml of another run" "'swapped.partial/history.csv'" "'swapped.partial/checkpoint.gpack'"
+expect 0 "the stopped run itself resumes" -- "$gpa" run --resume stopped-long -q
+same_as_whole stopped-long "stopped-long resumed"
+
 # --- a full disk -----------------------------------------------------------------------------
 if [[ $(id -u) -eq 0 ]] && mkdir -p small && mount -t tmpfs -o size=1m tmpfs small 2> /dev/null; then
   trap 'umount "$work/small" 2> /dev/null; umount "$work/tiny-disk" 2> /dev/null' EXIT
