@@ -217,29 +217,35 @@ std::uint64_t file_bytes(const fs::path& file) {
 }
 
 // The disk a run's outputs will take, from the size of its first snapshot, checked against the
-// free space of its folder before the first step.
-void check_disk(const Simulation& sim, const SnapshotSchedule& schedule, const fs::path& folder, std::uint64_t snapshot_bytes) {
+// free space of its folder before the first step. A resumed run passes `kept`, the scheduled
+// snapshots already in its folder: they, the history so far and the checkpoint are on the disk
+// already, and only what the rest of the run adds must fit.
+void check_disk(const Simulation& sim, const SnapshotSchedule& schedule, const fs::path& folder, std::uint64_t snapshot_bytes,
+                std::optional<std::size_t> kept = std::nullopt) {
     const Scene& s = sim.scene();
     // Steps: from the first time step to the end time, or max_steps, whichever is fewer.
     double steps = std::numeric_limits<double>::infinity();
     if (s.stop.end_time > 0.0 && sim.next_time_step() > 0.0) steps = std::ceil((s.stop.end_time - sim.time()) / sim.next_time_step());
     if (s.stop.max_steps > 0) steps = std::min(steps, double(s.stop.max_steps - std::min(s.stop.max_steps, sim.steps())));
     // Snapshots: the scheduled ones up to the end time (or the time max_steps reach at the first
-    // step's length), at most one per step.
+    // step's length), at most one per step; on resume, less those written (but the last one).
     double end = s.stop.end_time > 0.0 ? s.stop.end_time : std::numeric_limits<double>::infinity();
     if (s.stop.max_steps > 0) end = std::min(end, sim.time() + steps * sim.next_time_step());
     double snapshots = schedule.planned(end);
+    if (kept) snapshots = std::max(snapshots - double(*kept), 1.0);
     if (std::isfinite(steps)) snapshots = std::min(snapshots, steps + 2.0);
     const double rows = std::isfinite(steps) ? steps / double(std::max<std::size_t>(s.output.history_every, 1)) + 2.0 : 0.0;
-    // A checkpoint is about the node store and the lists; two exist while one replaces the other.
-    const double checkpoint = 2.0 * double(sim.nodes().size()) * bytes_per_node_besides_lists(sim.nodes().dim()) / 2.0 +
-                              2.0 * 4.0 * double(sim.totals().pairs);
+    // A checkpoint is about the node store and the lists; two exist while one replaces the other
+    // (on resume, one of them is there already).
+    const double checkpoint = (kept ? 1.0 : 2.0) * (double(sim.nodes().size()) * bytes_per_node_besides_lists(sim.nodes().dim()) / 2.0 +
+                                                    4.0 * double(sim.totals().pairs));
     const double bytes = snapshots * double(snapshot_bytes) + rows * 400.0 + checkpoint;
     const double available = double(free_bytes(folder));
     if (bytes > available) {
-        throw LimitError(fmt::format("the run's outputs need an estimated {} of disk ({:.3g} snapshots of {} each{}, the "
+        throw LimitError(fmt::format("{} need an estimated {} of disk ({:.3g} {}snapshots of {} each{}, the "
                                      "history and a checkpoint); the file system of '{}' has {} free",
-                                     format_bytes(bytes), snapshots, format_bytes(double(snapshot_bytes)),
+                                     kept ? "the outputs the rest of the resumed run adds" : "the run's outputs", format_bytes(bytes),
+                                     snapshots, kept ? "more " : "", format_bytes(double(snapshot_bytes)),
                                      std::isfinite(steps) && snapshots >= steps ? ", one per step" : "", folder.string(),
                                      format_bytes(available)));
     }
@@ -367,7 +373,8 @@ public:
                                                           state_.snapshots.begin(), state_.snapshots.end(),
                                                           [](const io::PvdEntry& e) { return e.part == 0; })));
         check_disk(sim_, schedule_, folder_.partial(),
-                   state_.snapshots.empty() ? 0 : file_bytes(folder_.partial() / state_.snapshots.front().file));
+                   state_.snapshots.empty() ? 0 : file_bytes(folder_.partial() / state_.snapshots.front().file),
+                   snapshots_.series().scheduled());
     }
 
     int run() {

@@ -280,6 +280,27 @@ if [[ $(id -u) -eq 0 ]] && mkdir -p small && mount -t tmpfs -o size=1m tmpfs sma
   says err.txt "of disk" "disk estimate"
   [[ -e tiny-disk/many.partial ]] && fail "the disk refusal left its folder"
   umount tiny-disk
+  # Resume needs room only for what the rest of the run adds (issue 21, item 3): 121 snapshots of
+  # 15 kB in all, a checkpoint at step 8000 of 12000, then 1.1 MB left free, more than the last
+  # 41 snapshots take but less than all of them.
+  mkdir -p room && mount -t tmpfs -o size=4m tmpfs room
+  trap 'umount "$work/room" 2> /dev/null' EXIT
+  variant room.toml -e 's/^max_steps = 20/max_steps = 12000/' \
+    -e 's/^snapshots = 3/snapshot_interval = "1.5 us"\nhistory_every = 100\ncheckpoint_every = 8000/'
+  expect 0 "room: whole" -- "$gpa" run room.toml -o room-whole -q --threads 1
+  "$gpa" run room.toml -o room/run -q --threads 1 > /dev/null 2>&1 &
+  pid=$!
+  wait_for_file room/run.partial/checkpoint.gpack || fail "room: no checkpoint"
+  kill -9 $pid; wait $pid 2> /dev/null
+  avail=$(df -B1 --output=avail room | tail -1)
+  dd if=/dev/zero of=room/filler bs=1k count=$(( (avail - 1100000) / 1024 )) 2> /dev/null
+  expect 0 "resume with room for the rest of the run" -- "$gpa" run --resume room/run -q --threads 1
+  if [[ -d room/run ]]; then
+    for f in room-whole/particles_*.vtp room-whole/history.csv room-whole/particles.pvd; do
+      cmp -s "$f" "room/run/$(basename "$f")" || fail "room: resumed $(basename "$f") differs from the uninterrupted run's"
+    done
+  fi
+  umount room
   trap - EXIT
 else
   echo "SKIP: full-disk cases need root and tmpfs (the gtest DiskFull cases inject the failure instead)"
