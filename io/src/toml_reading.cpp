@@ -358,6 +358,13 @@ double read_quantity(const Reporter& reporter, const toml::node& node, const std
                 reporter.fail(line, key_path, fmt::format("{} must not be negative", as_written(node)));
             }
             break;
+        case Limit::BelowLightSpeed:
+            if (!(std::abs(value) < speed_of_light)) {
+                reporter.fail(line, key_path,
+                              fmt::format("{} is out of range: a velocity must be below the speed of light, {} m/s", as_written(node),
+                                          speed_of_light));
+            }
+            break;
     }
     return value;
 }

@@ -58,7 +58,13 @@ enum class Limit {
     Positive,              // > 0, finite
     NonNegative,           // >= 0, finite
     PositiveOrInfinite,    // > 0, +inf allowed (means "no limit")
+    BelowLightSpeed,       // |value| < the speed of light (a velocity component)
 };
+
+// The speed no velocity of a scene reaches (m/s): the mechanics is Newtonian, and a value at or
+// beyond it is a slip (1e300 for 300), better refused where it is written than as an impossible
+// time step or disk estimate later.
+inline constexpr double speed_of_light = 299792458.0;
 
 // A pair of a word in the file and the value it stands for.
 template <class T>
