@@ -580,6 +580,10 @@ int resumed_run(const RunOptions& options) {
     io::RunFolder folder(*options.resume, false, io::RunFolder::Mode::Resume);
     const fs::path checkpoint = folder.partial() / checkpoint_name;
     if (!fs::exists(checkpoint)) {
+        std::error_code ec;
+        if (fs::is_empty(folder.partial(), ec)) {
+            throw io::OutputError(fmt::format("'{}' is empty: there is nothing to resume", folder.partial().string()));
+        }
         throw io::OutputError(fmt::format("'{}' holds no checkpoint: the run stopped before it wrote one (output.checkpoint_every); "
                                           "start it again",
                                           folder.partial().string()));

@@ -32,9 +32,13 @@ RunFolder::RunFolder(fs::path folder, bool overwrite, Mode mode) : final_(std::m
     std::error_code ec;
     if (mode == Mode::Resume) {
         if (!fs::is_directory(partial_, ec)) {
+            // Say what the folder is: a finished run's (it has its summary), empty, or something else.
+            std::string what;
+            if (fs::exists(final_ / "summary.json", ec)) what = " (the run in it has finished)";
+            else if (fs::is_directory(final_, ec) && fs::is_empty(final_, ec)) what = fmt::format(", and '{}' is empty: there is nothing to resume", final_.string());
+            else if (fs::is_directory(final_, ec)) what = fmt::format(", and '{}' holds no gpa run: there is nothing to resume", final_.string());
             throw OutputError(fmt::format("there is no stopped run to resume in '{}': '{}' does not exist{}", final_.string(),
-                                          partial_.string(),
-                                          fs::is_directory(final_, ec) ? " (the run in it has finished)" : ""));
+                                          partial_.string(), what));
         }
         return;
     }

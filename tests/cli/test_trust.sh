@@ -189,6 +189,12 @@ cmp -s pulled-whole/history.csv pulled-killed/history.csv || fail "pulled: the r
 # What cannot be resumed is refused.
 expect 2 "resume a finished run" -- "$gpa" run --resume whole -q
 says err.txt "has finished" "resume a finished run"
+mkdir -p empty-run
+expect 2 "resume an empty folder" -- "$gpa" run --resume empty-run -q
+says err.txt "'empty-run' is empty: there is nothing to resume" "resume an empty folder"
+mkdir -p empty-partial.partial
+expect 2 "resume an empty DIR.partial" -- "$gpa" run --resume empty-partial -q
+says err.txt "'empty-partial.partial' is empty: there is nothing to resume" "resume an empty DIR.partial"
 "$gpa" run long.toml -o other -q > /dev/null 2>&1 &
 pid=$!
 wait_for_lines other.partial/history.csv 30
