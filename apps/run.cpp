@@ -330,6 +330,7 @@ public:
         history_.emplace(folder_.partial() / "history.csv", sim_.totals(), dimension_of(sim_.scene().geometry));
         history_->write(sim_.totals());
         last_row_ = sim_.steps();
+        scheduled_rows_ = history_->mark();
         snapshots_.write(sim_);
         snapshots_.wait();  // its size is the disk estimate's unit
         check_disk(sim_, schedule_, folder_.partial(), file_bytes(folder_.partial() / snapshots_.series().entries()[0].file));
@@ -341,6 +342,10 @@ public:
         const Scene& scene = sim_.scene();
         const std::size_t every = std::max<std::size_t>(scene.output.history_every, 1);
         const std::string checkpoint = (folder_.partial() / checkpoint_name).string();
+        sim_.measure_bodies();
+        const fs::path history_file = folder_.partial() / "history.csv";
+        const std::string kept_history = io::HistoryWriter::kept_for_resume(history_file, sim_.totals(), dimension_of(scene.geometry),
+                                                                            checkpoint_step, every, state_.history, checkpoint);
         // Every snapshot the checkpoint lists must be there and whole (a writer's file ends with
         // its closing tag); the .pvd rewritten below lists them all.
         for (const auto& e : state_.snapshots) {
@@ -353,9 +358,9 @@ public:
                                                   file.string(), present ? "is not whole" : "is missing", e.time * 1e6, checkpoint));
             }
         }
-        sim_.measure_bodies();
-        history_.emplace(folder_.partial() / "history.csv", sim_.totals(), dimension_of(scene.geometry), checkpoint_step, every,
-                         state_.history, checkpoint);
+        // Checked: from here on the folder is cut back to the checkpoint.
+        history_.emplace(history_file, sim_.totals(), dimension_of(scene.geometry), kept_history);
+        scheduled_rows_ = history_->mark();
         last_row_ = checkpoint_step;
         schedule_.set_last_slot(state_.snapshot_slot);
         snapshots_.add_seconds(state_.output_seconds);
@@ -428,6 +433,7 @@ private:
         sim_.measure_bodies();  // the summary reports the bodies as of the last row too
         history_->write(sim_.totals());
         last_row_ = sim_.steps();
+        if (sim_.steps() % std::max<std::size_t>(sim_.scene().output.history_every, 1) == 0) scheduled_rows_ = history_->mark();
     }
 
     void write_checkpoint(double wall_seconds) {
@@ -439,7 +445,9 @@ private:
         s.wall_seconds = wall_seconds;
         s.output_seconds = snapshots_.seconds();
         s.snapshot_slot = schedule_.last_slot();
-        s.history = history_->mark();
+        // The history up to its last scheduled row: a row off the schedule (that of an
+        // interruption) is not part of the run a resume continues, and goes when it resumes.
+        s.history = scheduled_rows_;
         s.snapshots.clear();
         for (const auto& e : snapshots_.series().entries()) {
             if (e.name.empty()) s.snapshots.push_back(e);
@@ -544,6 +552,7 @@ private:
     SnapshotWriter snapshots_;
     std::optional<io::HistoryWriter> history_;
     std::size_t last_row_ = 0;  // the step of the last history row
+    io::HistoryWriter::Mark scheduled_rows_;  // history.csv as of its last row on the schedule (steps 0, every, ...)
 };
 
 int fresh_run(const RunOptions& options) {

@@ -164,10 +164,8 @@ HistoryWriter::HistoryWriter(const fs::path& file, const Totals& first, int dim)
     append(history_header(first, dim));
 }
 
-HistoryWriter::HistoryWriter(const fs::path& file, const Totals& first, int dim, std::size_t last_step, std::size_t every,
-                             Mark at, const std::string& checkpoint)
-    : path_(file), dim_(dim), planes_(first.planes.size()) {
-    for (const auto& r : first.regions) regions_.push_back(r.held);
+std::string HistoryWriter::kept_for_resume(const fs::path& file, const Totals& first, int dim, std::size_t last_step,
+                                           std::size_t every, Mark at, const std::string& checkpoint) {
     every = std::max<std::size_t>(every, 1);
     std::string old;
     {
@@ -223,6 +221,12 @@ HistoryWriter::HistoryWriter(const fs::path& file, const Totals& first, int dim,
         throw OutputError(fmt::format("'{}' has been cut short: it has no row of step {}, though '{}' was written at step {}; {}",
                                       file.string(), next, checkpoint, last_step, cannot));
     }
+    return text;
+}
+
+HistoryWriter::HistoryWriter(const fs::path& file, const Totals& first, int dim, const std::string& text)
+    : path_(file), dim_(dim), planes_(first.planes.size()) {
+    for (const auto& r : first.regions) regions_.push_back(r.held);
     write_text_file(file, text);
     fd_ = ::open(file.c_str(), O_WRONLY | O_APPEND | O_CLOEXEC);
     if (fd_ < 0) throw OutputError(fmt::format("cannot write '{}': {}", file.string(), std::strerror(errno)));

@@ -64,15 +64,17 @@ public:
         std::uint64_t digest = 0;
     };
     HistoryWriter(const std::filesystem::path& file, const Totals& first, int dim);
-    // For a resumed run from a checkpoint at step `last_step`: the file as it was at the
-    // checkpoint (its first at.bytes bytes, which must have the recorded digest; what follows is
-    // cut off) with the rows of steps 0, every, 2 every, ... up to last_step, which must all be
-    // there; rows beyond them go (the file is rewritten atomically) and the run appends after
-    // them. Checked before the file is changed: OutputError naming the file (and `checkpoint`)
-    // when it is missing, its header is not the one this run writes, it is shorter than at the
-    // checkpoint, it differs from the one the checkpoint recorded, or a row is missing.
-    HistoryWriter(const std::filesystem::path& file, const Totals& first, int dim, std::size_t last_step, std::size_t every,
-                  Mark at, const std::string& checkpoint);
+    // For a resumed run from a checkpoint at step `last_step`, what of the file it keeps: the
+    // file as it was at the checkpoint (its first at.bytes bytes, which must have the recorded
+    // digest; what follows goes) with the rows of steps 0, every, 2 every, ... up to last_step,
+    // which must all be there. Reads the file and changes nothing: OutputError naming the file
+    // (and `checkpoint`) when it is missing, its header is not the one this run writes, it is
+    // shorter than at the checkpoint, it differs from the one the checkpoint recorded, or a row
+    // is missing.
+    static std::string kept_for_resume(const std::filesystem::path& file, const Totals& first, int dim, std::size_t last_step,
+                                       std::size_t every, Mark at, const std::string& checkpoint);
+    // A resumed run: the file rewritten (atomically) to `kept` (kept_for_resume), and appended to.
+    HistoryWriter(const std::filesystem::path& file, const Totals& first, int dim, const std::string& kept);
     ~HistoryWriter();
     HistoryWriter(const HistoryWriter&) = delete;
     HistoryWriter& operator=(const HistoryWriter&) = delete;
