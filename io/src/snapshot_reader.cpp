@@ -19,6 +19,7 @@
 #include <fmt/format.h>
 
 #include "toml_include.hpp"
+#include "toml_reading.hpp"
 
 namespace gpa::io {
 
@@ -749,10 +750,10 @@ std::optional<RunGeometry> read_run_geometry(const fs::path& folder) {
     if (fs::is_regular_file(scene, ec)) {
         std::string name;
         try {
-            const toml::table table = toml::parse_file(scene.string());
+            const toml::table table = detail::read_guarded_toml(scene);
             if (const auto* g = table.get_as<std::string>("geometry")) name = g->get();
-        } catch (const toml::parse_error& e) {
-            fail(scene, fmt::format("cannot be read as TOML ({}); give the geometry with --geometry", e.description()));
+        } catch (const InputError& e) {
+            throw SnapshotError(fmt::format("{}; give the geometry with --geometry", e.what()));  // e names the file
         }
         if (const auto g = geometry_named(name)) return RunGeometry{*g, "scene.toml"};
         fail(scene, fmt::format("geometry '{}' is none of axisymmetric, plane-strain, 3d", name));

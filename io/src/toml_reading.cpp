@@ -317,6 +317,13 @@ toml::table parse_toml(std::string_view text, const Reporter& reporter) {
     }
 }
 
+toml::table read_guarded_toml(const std::filesystem::path& file) {
+    const std::string text = read_scene_text(file);
+    const Reporter reporter(file.string());
+    check_text(text, reporter);
+    return parse_toml(text, reporter);
+}
+
 std::optional<std::string_view> closest(std::string_view word, const std::vector<std::string_view>& candidates) {
     std::optional<std::string_view> best;
     std::size_t best_distance = std::numeric_limits<std::size_t>::max();

@@ -4,6 +4,7 @@
 
 #include <cstddef>
 #include <initializer_list>
+#include <filesystem>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -47,6 +48,11 @@ void check_non_ascii_placement(std::string_view text, const Reporter& reporter);
 
 // Parses TOML text, turning syntax errors into "file:line:column: TOML syntax error: ...".
 toml::table parse_toml(std::string_view text, const Reporter& reporter);
+
+// Any other TOML file a user can hand gpa (an element reference, the scene.toml a renderer reads
+// in a run folder), read through the same guards as a scene (size, check_text) before toml++
+// sees it: SceneError naming the file (and line) for what they or the parser refuse.
+toml::table read_guarded_toml(const std::filesystem::path& file);
 
 // The closest of `candidates` to `word` (edit distance, letter case ignored), if close enough
 // to be a likely typo.

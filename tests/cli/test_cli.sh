@@ -129,6 +129,12 @@ expect 2 "a folder as the element reference" -- "$gpa" check bar-ref-folder.toml
 grep -q "reference.elements: .*ref-folder: is a folder, not an element reference file" err.txt || fail "folder as reference: $(cat err.txt)"
 expect 2 "an empty file as the element reference" -- "$gpa" check bar-ref-empty.toml.toml
 grep -q "reference.elements: .*ref-empty.toml: the file is empty" err.txt || fail "empty reference: $(cat err.txt)"
+#    A reference of bytes the TOML parser must not see (a non-ASCII character after a quote in a
+#    bare value: undefined behaviour in toml++ 3.3.0) goes through the scene's guard (issue 21, item 6).
+printf 'scene = "x"\nkind = 2"\317\273"\n' > ref-bytes.toml
+sed "s#^source = \"one-dimensional elastic wave theory\"#&\nelements = \"$PWD/ref-bytes.toml\"#" "$bar" > bar-ref-bytes.toml
+expect 2 "a reference the TOML parser must not see" -- "$gpa" check bar-ref-bytes.toml
+grep -q "ref-bytes.toml:2: a non-ASCII character outside a quoted string" err.txt || fail "reference bytes: $(cat err.txt)"
 #    A relative reference is found beside the scene file, whatever the working folder (as the
 #    scenes in scenes/ name theirs), by run and study alike.
 mkdir -p sub/references && cp ref.toml sub/references/bar.elements.toml

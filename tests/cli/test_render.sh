@@ -107,6 +107,10 @@ LC_ALL=C grep -q '[^[:print:]]' err.txt && fail "vtp of random bytes: the messag
 printf '<?xml version="1.0"?>\n<VTKFile type="PolyData"><Pi\317\273\001 /a\002=x>' > broken/particles_00001.vtp
 refused "vtp with raw bytes in its XML" "broken/particles_00001.vtp: malformed XML" broken
 LC_ALL=C grep -q '[^[:print:]]' err.txt && fail "vtp with raw bytes in its XML: the message shows raw bytes: $(od -c err.txt | head -5)"
+# The run's scene.toml, read for its geometry, goes through the scene's guard (issue 21, item 6).
+cp -r run bytes-run
+printf 'geometry = 2"\317\273"\n' > bytes-run/scene.toml
+refused "scene.toml the TOML parser must not see" "bytes-run/scene.toml:1: a non-ASCII character outside a quoted string" bytes-run
 expect 0 "another snapshot of the broken folder still renders" -- "$gpa" render broken --snapshot 0 -o zero.png -q
 
 echo "$failures failure(s)"
