@@ -390,7 +390,7 @@ public:
         const Scene& scene = sim_.scene();
         const std::size_t every = std::max<std::size_t>(scene.output.history_every, 1);
         Progress progress(options_.quiet);
-        StopRequests stop;
+        StopRequests stop(sim_.can_checkpoint());
         auto last_checkpoint = std::chrono::steady_clock::now();
         int stop_signal = 0;
         try {
@@ -502,9 +502,11 @@ private:
         } catch (const std::exception& e) {
             problem = e.what();
         }
-        fmt::print(stderr, "gpa: the run was stopped by {} after step {} at t = {:.4g} us{}\n", name, sim_.steps(), sim_.time() * 1e6,
-                   problem.empty() ? fmt::format("; resume it with: gpa run --resume {}", folder_.final_path().string())
-                                   : fmt::format(", and saving it failed: {}", problem));
+        std::string next;
+        if (!problem.empty()) next = fmt::format(", and saving it failed: {}", problem);
+        else if (!sim_.can_checkpoint()) next = "; element bodies cannot be checkpointed yet, so it cannot be resumed: start it again";
+        else next = fmt::format("; resume it with: gpa run --resume {}", folder_.final_path().string());
+        fmt::print(stderr, "gpa: the run was stopped by {} after step {} at t = {:.4g} us{}\n", name, sim_.steps(), sim_.time() * 1e6, next);
         return 128 + signo;
     }
 
@@ -593,6 +595,20 @@ int resumed_run(const RunOptions& options) {
         if (fs::is_empty(folder.partial(), ec)) {
             throw io::OutputError(fmt::format("'{}' is empty: there is nothing to resume", folder.partial().string()));
         }
+        // A run of element bodies never writes one: say so rather than blame checkpoint_every.
+        bool elements = false;
+        try {
+            const Scene copied = io::parse_scene(io::read_scene_text(folder.partial() / scene_copy_name), scene_copy_name);
+            elements = std::any_of(copied.bodies.begin(), copied.bodies.end(),
+                                   [](const BodySpec& b) { return b.discretisation == Discretisation::Elements; });
+        } catch (const std::exception&) {
+            // No readable copy: the message below stands.
+        }
+        if (elements) {
+            throw io::OutputError(fmt::format("'{}' holds no checkpoint: its scene has element bodies, which cannot be checkpointed "
+                                              "yet, so the run cannot be resumed: start it again",
+                                              folder.partial().string()));
+        }
         throw io::OutputError(fmt::format("'{}' holds no checkpoint: the run stopped before it wrote one (output.checkpoint_every); "
                                           "start it again",
                                           folder.partial().string()));
@@ -680,6 +696,10 @@ int check_scene(const fs::path& file, const MemoryLimit& memory) {
                    r.ramp > 0.0 ? fmt::format(" after a {:.4g} us ramp", r.ramp * 1e6) : std::string());
     }
     fmt::print("  first time step {:.3g} ns; phases: {}\n", sim.next_time_step() * 1e9, fmt::join(sim.phases(), ", "));
+    if (!sim.can_checkpoint()) {
+        fmt::print("  no checkpoints (checkpoint_every does not apply): element bodies cannot be checkpointed yet, so an "
+                   "interrupted run of this scene cannot be resumed\n");
+    }
     return 0;
 }
 
