@@ -354,7 +354,7 @@ public:
             const bool present = fs::is_regular_file(file, ec);
             if (!present || !ends_with_closing_tag(file)) {
                 throw io::OutputError(fmt::format("'{}' {} (the snapshot of t = {:.6g} us that '{}' lists): the stopped run cannot "
-                                                  "be continued from it (gpa run --overwrite starts it again)",
+                                                  "be continued from it (start it again with --overwrite)",
                                                   file.string(), present ? "is not whole" : "is missing", e.time * 1e6, checkpoint));
             }
         }
@@ -622,7 +622,7 @@ int resumed_run(const RunOptions& options) {
         if (!options.scene) {
             // The folder's own copy: the two files came from different runs.
             throw CheckpointError(fmt::format("'{}' and '{}' are not of the same run (the checkpoint was written for another scene): "
-                                              "the stopped run cannot be continued from them (gpa run --overwrite starts it again)",
+                                              "the stopped run cannot be continued from them (start it again with --overwrite)",
                                               checkpoint.string(), copy.string()));
         }
         throw CheckpointError(fmt::format("'{}' is not the scene the run in '{}' started with (its copy is '{}')", source.name,

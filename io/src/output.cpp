@@ -174,7 +174,7 @@ std::string HistoryWriter::kept_for_resume(const fs::path& file, const Totals& f
         old.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
         if (in.bad()) throw OutputError(fmt::format("cannot read '{}' of the stopped run", file.string()));
     }
-    const std::string cannot = "the stopped run cannot be continued from it (gpa run --overwrite starts it again)";
+    const std::string cannot = "the stopped run cannot be continued from it (start it again with --overwrite)";
     if (at.bytes > 0) {
         // What was written after the checkpoint goes; what was written before must be as it was.
         if (static_cast<long long>(old.size()) < at.bytes) {
