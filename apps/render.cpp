@@ -174,11 +174,11 @@ int render_run(const RenderCommandOptions& o) {
                                          io::min_width, io::max_side, io::min_height, io::max_side));
         }
     }
-    if (o.width != 0) {
-        if (o.width < io::min_width || o.width > io::max_side) {
-            throw InputError(fmt::format("--width {}: it must be {} to {} pixels", o.width, io::min_width, io::max_side));
+    if (o.width) {  // given, 0 included: the default width is taken only when the option is left out
+        if (*o.width < io::min_width || *o.width > io::max_side) {
+            throw InputError(fmt::format("--width {}: it must be {} to {} pixels", *o.width, io::min_width, io::max_side));
         }
-        options.width = o.width;
+        options.width = *o.width;
     }
     if (!o.view.empty()) {
         options.view = io::view_direction_named(o.view);

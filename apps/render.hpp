@@ -15,7 +15,7 @@ struct RenderCommandOptions {
     std::string snapshot;          // "N", "last" or "" (the last)
     std::string time;              // "40 us", "4e-5": the snapshot nearest to it
     std::string size;              // "WxH", as typed
-    int width = 0;                 // --width; 0: the default
+    std::optional<int> width;      // --width; none: the default
     std::string range;             // "MIN:MAX", either side may be empty (the field's own)
     bool mirror = false, no_mirror = false;
     std::string view;              // 3D: "+y", "-z", ...

@@ -6,6 +6,7 @@
 #include <csignal>
 #include <ctime>
 #include <exception>
+#include <fstream>
 #include <future>
 #include <limits>
 #include <sstream>
@@ -37,7 +38,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr const char* checkpoint_name = "checkpoint.gpack";
+constexpr const char* checkpoint_name = io::checkpoint_file_name;
 constexpr const char* scene_copy_name = "scene.toml";
 
 // The scene's text and what messages call it.
@@ -137,6 +138,7 @@ struct RunState {
     double wall_seconds = 0.0, output_seconds = 0.0;
     double snapshot_slot = 0.0;
     std::vector<io::PvdEntry> snapshots;  // the scheduled ones, in order
+    io::HistoryWriter::Mark history;      // history.csv as it was (not recorded by older checkpoints)
 };
 
 std::string encode(const RunState& s) {
@@ -146,6 +148,7 @@ std::string encode(const RunState& s) {
     out += fmt::format("scene_file={}\noverwrite={}\nwall_seconds={:.17g}\noutput_seconds={:.17g}\nsnapshot_slot={:.17g}\n",
                        scene, s.overwrite ? 1 : 0, s.wall_seconds, s.output_seconds, s.snapshot_slot);
     for (const auto& e : s.snapshots) out += fmt::format("snapshot={:.17g} {} {}\n", e.time, e.part, e.file);
+    out += fmt::format("history={} {:016x}\n", s.history.bytes, s.history.digest);
     return out;
 }
 
@@ -166,6 +169,13 @@ RunState decode(const std::string& text, const std::string& source) {
             else if (key == "wall_seconds") s.wall_seconds = std::stod(value);
             else if (key == "output_seconds") s.output_seconds = std::stod(value);
             else if (key == "snapshot_slot") s.snapshot_slot = std::stod(value);
+            else if (key == "history") {
+                const auto space = value.find(' ');
+                if (space == std::string::npos) throw std::invalid_argument(value);
+                s.history.bytes = std::stoll(value.substr(0, space));
+                s.history.digest = std::stoull(value.substr(space + 1), nullptr, 16);
+                if (s.history.bytes <= 0) throw std::invalid_argument(value);
+            }
             else if (key == "snapshot") {
                 const auto space = value.find(' ');
                 const auto second = space == std::string::npos ? space : value.find(' ', space + 1);
@@ -181,6 +191,19 @@ RunState decode(const std::string& text, const std::string& source) {
     return s;
 }
 
+// Whether a snapshot file ends with the tag that closes it (</VTKFile>, and a line end).
+bool ends_with_closing_tag(const fs::path& file) {
+    std::ifstream in(file, std::ios::binary);
+    const std::string tag = "</VTKFile>";
+    if (!in.seekg(0, std::ios::end)) return false;
+    const auto size = static_cast<long long>(in.tellg());
+    const long long tail = std::min<long long>(size, 64);
+    std::string end(static_cast<std::size_t>(tail), '\0');
+    if (!in.seekg(size - tail) || !in.read(end.data(), tail)) return false;
+    while (!end.empty() && (end.back() == '\n' || end.back() == '\r' || end.back() == ' ')) end.pop_back();
+    return end.size() >= tag.size() && end.compare(end.size() - tag.size(), tag.size(), tag) == 0;
+}
+
 std::uint64_t free_bytes(const fs::path& folder) {
     struct statvfs fs {};
     if (::statvfs(folder.c_str(), &fs) != 0) return std::numeric_limits<std::uint64_t>::max();
@@ -194,29 +217,35 @@ std::uint64_t file_bytes(const fs::path& file) {
 }
 
 // The disk a run's outputs will take, from the size of its first snapshot, checked against the
-// free space of its folder before the first step.
-void check_disk(const Simulation& sim, const SnapshotSchedule& schedule, const fs::path& folder, std::uint64_t snapshot_bytes) {
+// free space of its folder before the first step. A resumed run passes `kept`, the scheduled
+// snapshots already in its folder: they, the history so far and the checkpoint are on the disk
+// already, and only what the rest of the run adds must fit.
+void check_disk(const Simulation& sim, const SnapshotSchedule& schedule, const fs::path& folder, std::uint64_t snapshot_bytes,
+                std::optional<std::size_t> kept = std::nullopt) {
     const Scene& s = sim.scene();
     // Steps: from the first time step to the end time, or max_steps, whichever is fewer.
     double steps = std::numeric_limits<double>::infinity();
     if (s.stop.end_time > 0.0 && sim.next_time_step() > 0.0) steps = std::ceil((s.stop.end_time - sim.time()) / sim.next_time_step());
     if (s.stop.max_steps > 0) steps = std::min(steps, double(s.stop.max_steps - std::min(s.stop.max_steps, sim.steps())));
     // Snapshots: the scheduled ones up to the end time (or the time max_steps reach at the first
-    // step's length), at most one per step.
+    // step's length), at most one per step; on resume, less those written (but the last one).
     double end = s.stop.end_time > 0.0 ? s.stop.end_time : std::numeric_limits<double>::infinity();
     if (s.stop.max_steps > 0) end = std::min(end, sim.time() + steps * sim.next_time_step());
     double snapshots = schedule.planned(end);
+    if (kept) snapshots = std::max(snapshots - double(*kept), 1.0);
     if (std::isfinite(steps)) snapshots = std::min(snapshots, steps + 2.0);
     const double rows = std::isfinite(steps) ? steps / double(std::max<std::size_t>(s.output.history_every, 1)) + 2.0 : 0.0;
-    // A checkpoint is about the node store and the lists; two exist while one replaces the other.
-    const double checkpoint = 2.0 * double(sim.nodes().size()) * bytes_per_node_besides_lists(sim.nodes().dim()) / 2.0 +
-                              2.0 * 4.0 * double(sim.totals().pairs);
+    // A checkpoint is about the node store and the lists; two exist while one replaces the other
+    // (on resume, one of them is there already).
+    const double checkpoint = (kept ? 1.0 : 2.0) * (double(sim.nodes().size()) * bytes_per_node_besides_lists(sim.nodes().dim()) / 2.0 +
+                                                    4.0 * double(sim.totals().pairs));
     const double bytes = snapshots * double(snapshot_bytes) + rows * 400.0 + checkpoint;
     const double available = double(free_bytes(folder));
     if (bytes > available) {
-        throw LimitError(fmt::format("the run's outputs need an estimated {} of disk ({:.3g} snapshots of {} each{}, the "
+        throw LimitError(fmt::format("{} need an estimated {} of disk ({:.3g} {}snapshots of {} each{}, the "
                                      "history and a checkpoint); the file system of '{}' has {} free",
-                                     format_bytes(bytes), snapshots, format_bytes(double(snapshot_bytes)),
+                                     kept ? "the outputs the rest of the resumed run adds" : "the run's outputs", format_bytes(bytes),
+                                     snapshots, kept ? "more " : "", format_bytes(double(snapshot_bytes)),
                                      std::isfinite(steps) && snapshots >= steps ? ", one per step" : "", folder.string(),
                                      format_bytes(available)));
     }
@@ -301,18 +330,37 @@ public:
         history_.emplace(folder_.partial() / "history.csv", sim_.totals(), dimension_of(sim_.scene().geometry));
         history_->write(sim_.totals());
         last_row_ = sim_.steps();
+        scheduled_rows_ = history_->mark();
         snapshots_.write(sim_);
         snapshots_.wait();  // its size is the disk estimate's unit
         check_disk(sim_, schedule_, folder_.partial(), file_bytes(folder_.partial() / snapshots_.series().entries()[0].file));
     }
 
-    // A resumed run: its outputs cut back to what they were at the checkpoint.
+    // A resumed run: its outputs checked and cut back to what they were at the checkpoint.
+    // Whatever cannot be continued is refused before anything in the folder changes.
     void resume(std::size_t checkpoint_step) {
         const Scene& scene = sim_.scene();
         const std::size_t every = std::max<std::size_t>(scene.output.history_every, 1);
+        const std::string checkpoint = (folder_.partial() / checkpoint_name).string();
         sim_.measure_bodies();
-        history_.emplace(folder_.partial() / "history.csv", sim_.totals(), dimension_of(scene.geometry),
-                         [&](std::size_t step) { return step <= checkpoint_step && step % every == 0; });
+        const fs::path history_file = folder_.partial() / "history.csv";
+        const std::string kept_history = io::HistoryWriter::kept_for_resume(history_file, sim_.totals(), dimension_of(scene.geometry),
+                                                                            checkpoint_step, every, state_.history, checkpoint);
+        // Every snapshot the checkpoint lists must be there and whole (a writer's file ends with
+        // its closing tag); the .pvd rewritten below lists them all.
+        for (const auto& e : state_.snapshots) {
+            const fs::path file = folder_.partial() / e.file;
+            std::error_code ec;
+            const bool present = fs::is_regular_file(file, ec);
+            if (!present || !ends_with_closing_tag(file)) {
+                throw io::OutputError(fmt::format("'{}' {} (the snapshot of t = {:.6g} us that '{}' lists): the stopped run cannot "
+                                                  "be continued from it (start it again with --overwrite)",
+                                                  file.string(), present ? "is not whole" : "is missing", e.time * 1e6, checkpoint));
+            }
+        }
+        // Checked: from here on the folder is cut back to the checkpoint.
+        history_.emplace(history_file, sim_.totals(), dimension_of(scene.geometry), kept_history);
+        scheduled_rows_ = history_->mark();
         last_row_ = checkpoint_step;
         schedule_.set_last_slot(state_.snapshot_slot);
         snapshots_.add_seconds(state_.output_seconds);
@@ -330,7 +378,8 @@ public:
                                                           state_.snapshots.begin(), state_.snapshots.end(),
                                                           [](const io::PvdEntry& e) { return e.part == 0; })));
         check_disk(sim_, schedule_, folder_.partial(),
-                   state_.snapshots.empty() ? 0 : file_bytes(folder_.partial() / state_.snapshots.front().file));
+                   state_.snapshots.empty() ? 0 : file_bytes(folder_.partial() / state_.snapshots.front().file),
+                   snapshots_.series().scheduled());
     }
 
     int run() {
@@ -341,7 +390,7 @@ public:
         const Scene& scene = sim_.scene();
         const std::size_t every = std::max<std::size_t>(scene.output.history_every, 1);
         Progress progress(options_.quiet);
-        StopRequests stop;
+        StopRequests stop(sim_.can_checkpoint());
         auto last_checkpoint = std::chrono::steady_clock::now();
         int stop_signal = 0;
         try {
@@ -384,6 +433,7 @@ private:
         sim_.measure_bodies();  // the summary reports the bodies as of the last row too
         history_->write(sim_.totals());
         last_row_ = sim_.steps();
+        if (sim_.steps() % std::max<std::size_t>(sim_.scene().output.history_every, 1) == 0) scheduled_rows_ = history_->mark();
     }
 
     void write_checkpoint(double wall_seconds) {
@@ -395,6 +445,9 @@ private:
         s.wall_seconds = wall_seconds;
         s.output_seconds = snapshots_.seconds();
         s.snapshot_slot = schedule_.last_slot();
+        // The history up to its last scheduled row: a row off the schedule (that of an
+        // interruption) is not part of the run a resume continues, and goes when it resumes.
+        s.history = scheduled_rows_;
         s.snapshots.clear();
         for (const auto& e : snapshots_.series().entries()) {
             if (e.name.empty()) s.snapshots.push_back(e);
@@ -449,9 +502,11 @@ private:
         } catch (const std::exception& e) {
             problem = e.what();
         }
-        fmt::print(stderr, "gpa: the run was stopped by {} after step {} at t = {:.4g} us{}\n", name, sim_.steps(), sim_.time() * 1e6,
-                   problem.empty() ? fmt::format("; resume it with: gpa run --resume {}", folder_.final_path().string())
-                                   : fmt::format(", and saving it failed: {}", problem));
+        std::string next;
+        if (!problem.empty()) next = fmt::format(", and saving it failed: {}", problem);
+        else if (!sim_.can_checkpoint()) next = "; element bodies cannot be checkpointed yet, so it cannot be resumed: start it again";
+        else next = fmt::format("; resume it with: gpa run --resume {}", folder_.final_path().string());
+        fmt::print(stderr, "gpa: the run was stopped by {} after step {} at t = {:.4g} us{}\n", name, sim_.steps(), sim_.time() * 1e6, next);
         return 128 + signo;
     }
 
@@ -499,6 +554,7 @@ private:
     SnapshotWriter snapshots_;
     std::optional<io::HistoryWriter> history_;
     std::size_t last_row_ = 0;  // the step of the last history row
+    io::HistoryWriter::Mark scheduled_rows_;  // history.csv as of its last row on the schedule (steps 0, every, ...)
 };
 
 int fresh_run(const RunOptions& options) {
@@ -535,6 +591,24 @@ int resumed_run(const RunOptions& options) {
     io::RunFolder folder(*options.resume, false, io::RunFolder::Mode::Resume);
     const fs::path checkpoint = folder.partial() / checkpoint_name;
     if (!fs::exists(checkpoint)) {
+        std::error_code ec;
+        if (fs::is_empty(folder.partial(), ec)) {
+            throw io::OutputError(fmt::format("'{}' is empty: there is nothing to resume", folder.partial().string()));
+        }
+        // A run of element bodies never writes one: say so rather than blame checkpoint_every.
+        bool elements = false;
+        try {
+            const Scene copied = io::parse_scene(io::read_scene_text(folder.partial() / scene_copy_name), scene_copy_name);
+            elements = std::any_of(copied.bodies.begin(), copied.bodies.end(),
+                                   [](const BodySpec& b) { return b.discretisation == Discretisation::Elements; });
+        } catch (const std::exception&) {
+            // No readable copy: the message below stands.
+        }
+        if (elements) {
+            throw io::OutputError(fmt::format("'{}' holds no checkpoint: its scene has element bodies, which cannot be checkpointed "
+                                              "yet, so the run cannot be resumed: start it again",
+                                              folder.partial().string()));
+        }
         throw io::OutputError(fmt::format("'{}' holds no checkpoint: the run stopped before it wrote one (output.checkpoint_every); "
                                           "start it again",
                                           folder.partial().string()));
@@ -545,6 +619,12 @@ int resumed_run(const RunOptions& options) {
     SceneSource source = options.scene ? read_source(options.scene) : SceneSource{io::read_scene_text(copy), copy.string(), copy.string()};
     const CheckpointInfo info = io::checkpoint_info(checkpoint);
     if (info.scene_fingerprint != io::scene_fingerprint(source.text)) {
+        if (!options.scene) {
+            // The folder's own copy: the two files came from different runs.
+            throw CheckpointError(fmt::format("'{}' and '{}' are not of the same run (the checkpoint was written for another scene): "
+                                              "the stopped run cannot be continued from them (start it again with --overwrite)",
+                                              checkpoint.string(), copy.string()));
+        }
         throw CheckpointError(fmt::format("'{}' is not the scene the run in '{}' started with (its copy is '{}')", source.name,
                                           folder.partial().string(), copy.string()));
     }
@@ -616,6 +696,10 @@ int check_scene(const fs::path& file, const MemoryLimit& memory) {
                    r.ramp > 0.0 ? fmt::format(" after a {:.4g} us ramp", r.ramp * 1e6) : std::string());
     }
     fmt::print("  first time step {:.3g} ns; phases: {}\n", sim.next_time_step() * 1e9, fmt::join(sim.phases(), ", "));
+    if (!sim.can_checkpoint()) {
+        fmt::print("  no checkpoints (checkpoint_every does not apply): element bodies cannot be checkpointed yet, so an "
+                   "interrupted run of this scene cannot be resumed\n");
+    }
     return 0;
 }
 

@@ -1,6 +1,7 @@
 #include "signals.hpp"
 
 #include <csignal>
+#include <cstddef>
 
 #include <signal.h>
 #include <unistd.h>
@@ -10,6 +11,15 @@ namespace gpa::app {
 namespace {
 
 volatile std::sig_atomic_t stop_signal = 0;
+
+// What the handler writes: chosen before the handlers are installed, only read in them.
+const char with_checkpoint[] =
+    "\ngpa: stopping after this step: a snapshot, a checkpoint and the summary follow (signal again to stop at once)\n";
+const char without_checkpoint[] =
+    "\ngpa: stopping after this step: a snapshot and the summary follow, but no checkpoint (element bodies cannot be "
+    "checkpointed yet); signal again to stop at once\n";
+const char* stop_message = with_checkpoint;
+std::size_t stop_message_size = sizeof with_checkpoint - 1;
 struct sigaction previous_int {}, previous_term {};
 
 void on_stop_signal(int signo) {
@@ -20,16 +30,16 @@ void on_stop_signal(int signo) {
     sigemptyset(&fallback.sa_mask);
     ::sigaction(SIGINT, &fallback, nullptr);
     ::sigaction(SIGTERM, &fallback, nullptr);
-    static const char message[] =
-        "\ngpa: stopping after this step: a snapshot, a checkpoint and the summary follow (signal again to stop at once)\n";
-    const ssize_t ignored = ::write(STDERR_FILENO, message, sizeof message - 1);
+    const ssize_t ignored = ::write(STDERR_FILENO, stop_message, stop_message_size);
     (void)ignored;
 }
 
 }  // namespace
 
-StopRequests::StopRequests() {
+StopRequests::StopRequests(bool checkpoint) {
     stop_signal = 0;
+    stop_message = checkpoint ? with_checkpoint : without_checkpoint;
+    stop_message_size = checkpoint ? sizeof with_checkpoint - 1 : sizeof without_checkpoint - 1;
     struct sigaction action {};
     action.sa_handler = on_stop_signal;
     sigemptyset(&action.sa_mask);

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <iterator>
 #include <map>
 #include <system_error>
 
@@ -31,9 +32,13 @@ RunFolder::RunFolder(fs::path folder, bool overwrite, Mode mode) : final_(std::m
     std::error_code ec;
     if (mode == Mode::Resume) {
         if (!fs::is_directory(partial_, ec)) {
+            // Say what the folder is: a finished run's (it has its summary), empty, or something else.
+            std::string what;
+            if (fs::exists(final_ / "summary.json", ec)) what = " (the run in it has finished)";
+            else if (fs::is_directory(final_, ec) && fs::is_empty(final_, ec)) what = fmt::format(", and '{}' is empty: there is nothing to resume", final_.string());
+            else if (fs::is_directory(final_, ec)) what = fmt::format(", and '{}' holds no gpa run: there is nothing to resume", final_.string());
             throw OutputError(fmt::format("there is no stopped run to resume in '{}': '{}' does not exist{}", final_.string(),
-                                          partial_.string(),
-                                          fs::is_directory(final_, ec) ? " (the run in it has finished)" : ""));
+                                          partial_.string(), what));
         }
         return;
     }
@@ -46,6 +51,13 @@ RunFolder::RunFolder(fs::path folder, bool overwrite, Mode mode) : final_(std::m
                                           "or pass --overwrite to replace it when the run ends",
                                           final_.string()));
         }
+    }
+    // A stopped run that can still be resumed is work the user may want back: it is discarded
+    // only on request, and checked before anything else touches the folder.
+    if (!overwrite_ && fs::exists(partial_ / checkpoint_file_name, ec)) {
+        throw OutputError(fmt::format("'{}' holds a stopped run that can be resumed (it has a checkpoint); continue it with "
+                                      "gpa run --resume {}, or pass --overwrite to discard it and start again",
+                                      partial_.string(), final_.string()));
     }
     fs::remove_all(partial_, ec);
     if (ec) throw OutputError(fmt::format("cannot clear '{}': {}", partial_.string(), ec.message()));
@@ -136,6 +148,14 @@ std::string history_header(const Totals& first, int dim) {
 
 }  // namespace
 
+std::uint64_t history_digest(std::string_view bytes, std::uint64_t digest) {
+    for (const char c : bytes) {
+        digest ^= static_cast<unsigned char>(c);
+        digest *= 1099511628211ull;
+    }
+    return digest;
+}
+
 HistoryWriter::HistoryWriter(const fs::path& file, const Totals& first, int dim)
     : path_(file), dim_(dim), planes_(first.planes.size()) {
     for (const auto& r : first.regions) regions_.push_back(r.held);
@@ -144,29 +164,74 @@ HistoryWriter::HistoryWriter(const fs::path& file, const Totals& first, int dim)
     append(history_header(first, dim));
 }
 
-HistoryWriter::HistoryWriter(const fs::path& file, const Totals& first, int dim, const std::function<bool(std::size_t)>& keep)
-    : path_(file), dim_(dim), planes_(first.planes.size()) {
-    for (const auto& r : first.regions) regions_.push_back(r.held);
-    std::ifstream in(file, std::ios::binary);
-    if (!in) throw OutputError(fmt::format("cannot read '{}' of the stopped run", file.string()));
+std::string HistoryWriter::kept_for_resume(const fs::path& file, const Totals& first, int dim, std::size_t last_step,
+                                           std::size_t every, Mark at, const std::string& checkpoint) {
+    every = std::max<std::size_t>(every, 1);
+    std::string old;
+    {
+        std::ifstream in(file, std::ios::binary);
+        if (!in) throw OutputError(fmt::format("cannot read '{}' of the stopped run", file.string()));
+        old.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+        if (in.bad()) throw OutputError(fmt::format("cannot read '{}' of the stopped run", file.string()));
+    }
+    const std::string cannot = "the stopped run cannot be continued from it (start it again with --overwrite)";
+    if (at.bytes > 0) {
+        // What was written after the checkpoint goes; what was written before must be as it was.
+        if (static_cast<long long>(old.size()) < at.bytes) {
+            throw OutputError(fmt::format("'{}' has been cut short: it holds {} bytes, {} when '{}' was written at step {}; {}",
+                                          file.string(), old.size(), at.bytes, checkpoint, last_step, cannot));
+        }
+        old.resize(static_cast<std::size_t>(at.bytes));
+        if (history_digest(old) != at.digest) {
+            throw OutputError(fmt::format("'{}' is not the history '{}' was written with (its first {} bytes differ): the checkpoint "
+                                          "belongs to another run, or the history was changed; {}",
+                                          file.string(), checkpoint, at.bytes, cannot));
+        }
+    }
     const std::string header = history_header(first, dim);
-    std::string line, text;
-    if (!std::getline(in, line) || line + "\n" != header) {
+    if (old.compare(0, header.size(), header) != 0) {
         throw OutputError(fmt::format("'{}' does not start with the header this run writes", file.string()));
     }
-    text = header;
-    while (std::getline(in, line)) {
-        if (in.eof()) break;  // a last line without its end: not a whole row
+    // The rows of the schedule (steps 0, every, 2 every, ...) up to the checkpoint, each once and in
+    // order; rows off the schedule (the last one of an interruption) and beyond it are left out.
+    std::string text = header;
+    std::size_t next = 0;  // the step of the next row expected
+    std::size_t begin = header.size();
+    while (begin < old.size()) {
+        const std::size_t end = old.find('\n', begin);
+        if (end == std::string::npos) break;  // a last line without its end: not a whole row
+        const std::string_view line(old.data() + begin, end - begin);
+        begin = end + 1;
         const auto first_comma = line.find(','), second_comma = line.find(',', first_comma + 1);
         if (first_comma == std::string::npos || second_comma == std::string::npos) continue;
-        const std::string step = line.substr(second_comma + 1, line.find(',', second_comma + 1) - second_comma - 1);
-        if (step.empty() || step.find_first_not_of("0123456789") != std::string::npos) continue;
-        if (keep(static_cast<std::size_t>(std::stoull(step)))) text += line + "\n";
+        const std::string step_text(line.substr(second_comma + 1, line.find(',', second_comma + 1) - second_comma - 1));
+        if (step_text.empty() || step_text.find_first_not_of("0123456789") != std::string::npos) continue;
+        const std::size_t step = static_cast<std::size_t>(std::stoull(step_text));
+        if (step > last_step || step % every != 0) continue;
+        if (step != next) {
+            throw OutputError(fmt::format("'{}' has a row of step {} where the row of step {} belongs (rows every {} step{} up to "
+                                          "step {} of '{}'): {}",
+                                          file.string(), step, next, every, every == 1 ? "" : "s", last_step, checkpoint, cannot));
+        }
+        text.append(line);
+        text += '\n';
+        next += every;
     }
+    if (next <= last_step) {
+        throw OutputError(fmt::format("'{}' has been cut short: it has no row of step {}, though '{}' was written at step {}; {}",
+                                      file.string(), next, checkpoint, last_step, cannot));
+    }
+    return text;
+}
+
+HistoryWriter::HistoryWriter(const fs::path& file, const Totals& first, int dim, const std::string& text)
+    : path_(file), dim_(dim), planes_(first.planes.size()) {
+    for (const auto& r : first.regions) regions_.push_back(r.held);
     write_text_file(file, text);
     fd_ = ::open(file.c_str(), O_WRONLY | O_APPEND | O_CLOEXEC);
     if (fd_ < 0) throw OutputError(fmt::format("cannot write '{}': {}", file.string(), std::strerror(errno)));
     size_ = static_cast<long long>(text.size());
+    digest_ = history_digest(text);
 }
 
 HistoryWriter::~HistoryWriter() {
@@ -188,6 +253,7 @@ void HistoryWriter::append(const std::string& text) {
         done += static_cast<std::size_t>(n);
     }
     size_ += static_cast<long long>(text.size());
+    digest_ = history_digest(text, digest_);
 }
 
 void HistoryWriter::write(const Totals& t) {

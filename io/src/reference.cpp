@@ -13,6 +13,7 @@
 #include "gpa/io/output.hpp"
 #include "gpa/io/study.hpp"
 #include "toml_include.hpp"
+#include "toml_reading.hpp"
 
 namespace gpa::io {
 
@@ -159,13 +160,11 @@ ElementReference read_element_reference(const fs::path& file) {
     const auto fail = [&](const std::string& what) -> InputError {
         return InputError(fmt::format("{}: {}", file.string(), what));
     };
-    if (!fs::exists(file)) throw fail("no such element reference file (write one with gpa study --reference)");
-    toml::table t;
-    try {
-        t = toml::parse_file(file.string());
-    } catch (const toml::parse_error& e) {
-        throw fail(fmt::format("not a TOML file: {}", e.description()));
-    }
+    std::error_code ec;
+    if (!fs::exists(file, ec)) throw fail("no such element reference file (write one with gpa study --reference)");
+    if (fs::is_directory(file, ec)) throw fail("is a folder, not an element reference file (write one with gpa study --reference)");
+    const toml::table t = detail::read_guarded_toml(file);  // its errors name the file and line
+    if (t.empty()) throw fail("the file is empty (or holds only comments): an element reference holds what gpa study --reference writes");
     const auto text = [&](const toml::table& tab, const char* key, const std::string& where) {
         const auto* n = tab.get(key);
         if (!n || !n->is_string()) throw fail(fmt::format("{}{} must be a string", where, key));

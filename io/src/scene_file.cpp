@@ -132,6 +132,16 @@ std::string_view scene_phrase(GeometryKind g) {
 
 std::string_view components_of(int dim) { return dim == 2 ? "[x, z]" : "[x, y, z]"; }
 
+// Each component below the speed of light (Limit::BelowLightSpeed) may still add up to a speed
+// beyond it.
+void check_speed(const TableReader& r, std::string_view key, const std::array<double, 3>& v) {
+    const double speed = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    if (!(speed < speed_of_light)) {
+        r.fail_at(key, fmt::format("a speed of {:.4g} m/s is out of range: a velocity must be below the speed of light, {} m/s", speed,
+                                   speed_of_light));
+    }
+}
+
 std::array<double, 3> to_vector3(const std::vector<double>& v) {
     std::array<double, 3> out{0, 0, 0};
     for (std::size_t i = 0; i < v.size() && i < 3; ++i) out[i] = v[i];
@@ -251,8 +261,9 @@ BodySpec read_body(const Reporter& reporter, const toml::table& table, std::size
         if (dim == 3) r.fail_at("spacing_z", "applies to 2D scenes only: a 3D lattice has one spacing in every direction");
         b.spacing_z = *r.quantity("spacing_z", D::Length, Limit::Positive);
     }
-    if (const auto velocity = r.quantities("velocity", D::Velocity, static_cast<std::size_t>(dim), Limit::Any, components)) {
+    if (const auto velocity = r.quantities("velocity", D::Velocity, static_cast<std::size_t>(dim), Limit::BelowLightSpeed, components)) {
         b.velocity = to_vector3(*velocity);
+        check_speed(r, "velocity", {b.velocity[0], b.velocity[1], b.velocity[2]});
     }
     if (r.has("initial_stress")) b.initial_stress = read_initial_stress(r, geometry);
     if (const auto d = r.choice<Discretisation>("discretisation", {{"particles", Discretisation::Particles},
@@ -417,15 +428,16 @@ PrescribedVelocitySpec read_prescribed_velocity(const Reporter& reporter, const 
                                                "velocity = {}", components));
     }
     if (velocity->is_array()) {
-        const auto all = r.quantities("velocity", D::Velocity, static_cast<std::size_t>(dim), Limit::Any, components);
+        const auto all = r.quantities("velocity", D::Velocity, static_cast<std::size_t>(dim), Limit::BelowLightSpeed, components);
         for (int c = 0; c < dim; ++c) p.velocity[static_cast<std::size_t>(c)] = (*all)[static_cast<std::size_t>(c)];
     } else {
         for (const auto& [c, node] : component_table(r, "velocity", geometry, "{ z = \"5 m/s\" }")) {
             p.velocity[static_cast<std::size_t>(c)] =
                 read_quantity(reporter, *node, fmt::format("{}.{}", r.key_path("velocity"), component_names(dim)[static_cast<std::size_t>(c)]),
-                              D::Velocity, Limit::Any);
+                              D::Velocity, Limit::BelowLightSpeed);
         }
     }
+    check_speed(r, "velocity", {p.velocity[0].value_or(0.0), p.velocity[1].value_or(0.0), p.velocity[2].value_or(0.0)});
     if (const auto ramp = r.quantity("ramp", D::Time, Limit::NonNegative)) p.ramp = *ramp;
     return p;
 }
@@ -487,6 +499,10 @@ void read_reference(const Reporter& reporter, const toml::table& table, Scene& s
         if (key.str() == "source" || key.str() == "elements") {
             const auto* s = node.as_string();
             if (!s) reporter.fail(line, path, fmt::format("expected a string, got {}", type_name(node)));
+            if (key.str() == "elements" && s->get().empty()) {
+                reporter.fail(line, path, "the file name is empty: name the element reference (a file gpa study --reference wrote), "
+                                          "or leave the key out");
+            }
             (key.str() == "source" ? scene.reference_source : scene.element_reference) = s->get();
             continue;
         }

@@ -19,6 +19,7 @@
 #include <fmt/format.h>
 
 #include "toml_include.hpp"
+#include "toml_reading.hpp"
 
 namespace gpa::io {
 
@@ -26,8 +27,23 @@ namespace fs = std::filesystem;
 
 namespace {
 
+// Messages quote names out of the file (tags, attributes): a damaged or foreign file would put
+// its raw bytes on the terminal, so bytes outside printable ASCII are shown as \xNN and a long
+// message is cut.
+std::string printable_message(const std::string& what) {
+    constexpr std::size_t most = 300;
+    std::string out;
+    for (const char c : what) {
+        const auto u = static_cast<unsigned char>(c);
+        if (u >= 0x20 && u < 0x7f) out += c;
+        else out += fmt::format("\\x{:02x}", u);
+        if (out.size() >= most) return out + "...";
+    }
+    return out;
+}
+
 [[noreturn]] void fail(const fs::path& file, const std::string& what) {
-    throw SnapshotError(fmt::format("{}: {}", file.string(), what));
+    throw SnapshotError(fmt::format("{}: {}", file.string(), printable_message(what)));
 }
 
 std::string read_whole_file(const fs::path& file, const char* kind) {
@@ -77,6 +93,16 @@ std::string decode_entities(std::string_view text) {
 }
 
 bool is_space(char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r'; }
+
+// A VTK XML file (and a .pvd) opens with the XML declaration or its root element; anything else
+// is refused as `kind` ("not a VTK XML file") before its bytes are scanned as XML.
+void require_xml_start(const std::string& text, const fs::path& file, const std::string& kind) {
+    std::size_t start = text.compare(0, 3, "\xEF\xBB\xBF") == 0 ? 3 : 0;  // a UTF-8 byte order mark
+    while (start < text.size() && is_space(text[start])) ++start;
+    if (text.compare(start, 5, "<?xml") == 0 || text.compare(start, 8, "<VTKFile") == 0) return;
+    fail(file, text.empty() ? fmt::format("the file is empty: {}", kind)
+                            : fmt::format("{} (it does not start with <?xml or <VTKFile): the file is damaged or of another kind", kind));
+}
 
 class XmlScanner {
 public:
@@ -292,6 +318,7 @@ std::string location_phrase(DataLocation l) { return l == DataLocation::Point ? 
 
 SnapshotIndex read_pvd(const fs::path& pvd) {
     const std::string text = read_whole_file(pvd, "time-series index (.pvd)");
+    require_xml_start(text, pvd, "not a VTK time-series collection");
     XmlScanner xml(text, pvd);
     SnapshotIndex index{pvd, {}};
     bool collection = false;
@@ -394,6 +421,7 @@ VtkFile::VtkFile(fs::path path) : path_(std::move(path)) {
 VtkFile::VtkFile(fs::path name, std::string bytes) : path_(std::move(name)), bytes_(std::move(bytes)) { parse(); }
 
 void VtkFile::parse() {
+    require_xml_start(bytes_, path_, "not a VTK XML file");
     XmlScanner xml(bytes_, path_);
     std::vector<std::string> open;  // the elements we are inside
     bool root = false;
@@ -722,10 +750,10 @@ std::optional<RunGeometry> read_run_geometry(const fs::path& folder) {
     if (fs::is_regular_file(scene, ec)) {
         std::string name;
         try {
-            const toml::table table = toml::parse_file(scene.string());
+            const toml::table table = detail::read_guarded_toml(scene);
             if (const auto* g = table.get_as<std::string>("geometry")) name = g->get();
-        } catch (const toml::parse_error& e) {
-            fail(scene, fmt::format("cannot be read as TOML ({}); give the geometry with --geometry", e.description()));
+        } catch (const InputError& e) {
+            throw SnapshotError(fmt::format("{}; give the geometry with --geometry", e.what()));  // e names the file
         }
         if (const auto g = geometry_named(name)) return RunGeometry{*g, "scene.toml"};
         fail(scene, fmt::format("geometry '{}' is none of axisymmetric, plane-strain, 3d", name));

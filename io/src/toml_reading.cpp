@@ -181,9 +181,28 @@ void check_non_ascii_placement(std::string_view text, const Reporter& reporter) 
     // character after a backslash in a multi-line basic string and for the first character
     // after the line break that a line-ending backslash skips; a non-ASCII character there is
     // refused too (an escape such as \u03FB says the same).
+    //
+    // Where a quote opens a string is decided as toml++ decides it: only where a key or a value
+    // begins (after whitespace, =, [, {, or a comma, and after the dot of a dotted key). A quote
+    // inside a bare token (`geometry = 2"...`) is part of that token for toml++, which tests
+    // what follows against the same tables, so what follows is checked as outside a string.
+    // Keys and values are told apart by a small bracket stack: after = and inside an array a
+    // value comes, at a line's start (outside brackets) and after { or a comma of an inline
+    // table a key.
     enum class In { Nothing, Comment, Basic, Literal, MultiBasic, MultiLiteral };
     In in = In::Nothing;
     std::size_t line = 1;
+    std::string brackets;  // the open [ (array) and { (inline table) of values, innermost last
+    bool key = true;       // a key (not a value) would begin here
+    const auto opens_string = [&](std::size_t k) {
+        if (k == 0) return true;
+        const unsigned char before = static_cast<unsigned char>(text[k - 1]);
+        if (before == ' ' || before == '\t' || before == '\n' || before == '\r' || before == '=' || before == '[' ||
+            before == '{' || before == ',') {
+            return true;
+        }
+        return before == '.' && key;  // a dotted key: a."b"; in a value the dot belongs to a bare token (2.)
+    };
     const std::size_t n = text.size();
     const auto at = [&](std::size_t k) { return k < n ? static_cast<unsigned char>(text[k]) : 0u; };
     const auto run_of = [&](std::size_t k, unsigned char quote) {
@@ -199,11 +218,28 @@ void check_non_ascii_placement(std::string_view text, const Reporter& reporter) 
             case In::Nothing:
                 if (c == '#') {
                     in = In::Comment;
-                } else if (c == '"' || c == '\'') {
+                } else if ((c == '"' || c == '\'') && opens_string(i)) {
                     const bool multi = run_of(i, c) >= 3;
                     in = c == '"' ? (multi ? In::MultiBasic : In::Basic) : (multi ? In::MultiLiteral : In::Literal);
                     i += multi ? 3 : 1;
                     continue;
+                } else if (c == '\n') {
+                    if (brackets.empty()) key = true;
+                } else if (c == '=') {
+                    key = false;
+                } else if (c == '{') {
+                    brackets += '{';
+                    key = true;
+                } else if (c == '[') {
+                    if (!(key && brackets.empty())) {  // a table header's brackets ([a], [[a]]) hold a key
+                        brackets += '[';
+                        key = false;
+                    }
+                } else if (c == ']' || c == '}') {
+                    if (!brackets.empty() && brackets.back() == (c == ']' ? '[' : '{')) brackets.pop_back();
+                    if (!brackets.empty() || c == '}') key = false;
+                } else if (c == ',') {
+                    key = !brackets.empty() && brackets.back() == '{';
                 } else if (c >= 0x80) {
                     reporter.fail(line, "",
                                   "a non-ASCII character outside a quoted string or a comment: TOML allows them only "
@@ -211,7 +247,10 @@ void check_non_ascii_placement(std::string_view text, const Reporter& reporter) 
                 }
                 break;
             case In::Comment:
-                if (c == '\n') in = In::Nothing;
+                if (c == '\n') {
+                    in = In::Nothing;
+                    if (brackets.empty()) key = true;
+                }
                 break;
             case In::Literal:
                 if (c == '\'' || c == '\n') in = In::Nothing;
@@ -276,6 +315,13 @@ toml::table parse_toml(std::string_view text, const Reporter& reporter) {
         reporter.fail(where.line, "",
                       fmt::format("TOML syntax error (column {}): {}", where.column, e.description()));
     }
+}
+
+toml::table read_guarded_toml(const std::filesystem::path& file) {
+    const std::string text = read_scene_text(file);
+    const Reporter reporter(file.string());
+    check_text(text, reporter);
+    return parse_toml(text, reporter);
 }
 
 std::optional<std::string_view> closest(std::string_view word, const std::vector<std::string_view>& candidates) {
@@ -356,6 +402,13 @@ double read_quantity(const Reporter& reporter, const toml::node& node, const std
         case Limit::NonNegative:
             if (!(value >= 0.0)) {
                 reporter.fail(line, key_path, fmt::format("{} must not be negative", as_written(node)));
+            }
+            break;
+        case Limit::BelowLightSpeed:
+            if (!(std::abs(value) < speed_of_light)) {
+                reporter.fail(line, key_path,
+                              fmt::format("{} is out of range: a velocity must be below the speed of light, {} m/s", as_written(node),
+                                          speed_of_light));
             }
             break;
     }

@@ -4,6 +4,7 @@
 
 #include <cstddef>
 #include <initializer_list>
+#include <filesystem>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -48,6 +49,11 @@ void check_non_ascii_placement(std::string_view text, const Reporter& reporter);
 // Parses TOML text, turning syntax errors into "file:line:column: TOML syntax error: ...".
 toml::table parse_toml(std::string_view text, const Reporter& reporter);
 
+// Any other TOML file a user can hand gpa (an element reference, the scene.toml a renderer reads
+// in a run folder), read through the same guards as a scene (size, check_text) before toml++
+// sees it: SceneError naming the file (and line) for what they or the parser refuse.
+toml::table read_guarded_toml(const std::filesystem::path& file);
+
 // The closest of `candidates` to `word` (edit distance, letter case ignored), if close enough
 // to be a likely typo.
 std::optional<std::string_view> closest(std::string_view word, const std::vector<std::string_view>& candidates);
@@ -58,7 +64,13 @@ enum class Limit {
     Positive,              // > 0, finite
     NonNegative,           // >= 0, finite
     PositiveOrInfinite,    // > 0, +inf allowed (means "no limit")
+    BelowLightSpeed,       // |value| < the speed of light (a velocity component)
 };
+
+// The speed no velocity of a scene reaches (m/s): the mechanics is Newtonian, and a value at or
+// beyond it is a slip (1e300 for 300), better refused where it is written than as an impossible
+// time step or disk estimate later.
+inline constexpr double speed_of_light = 299792458.0;
 
 // A pair of a word in the file and the value it stands for.
 template <class T>

@@ -120,6 +120,21 @@ grep -q "reference.elements" err.txt || fail "the message does not name referenc
 expect 2 "run of a scene naming a missing reference" -- "$gpa" run bar-noref.toml -o run-noref -q
 grep -q "reference.elements" err.txt || fail "run: the message does not name reference.elements: $(cat err.txt)"
 [[ -e run-noref || -e run-noref.partial ]] && fail "run of a scene naming a missing reference left an output folder"
+#    A folder or an empty file named as the reference: the message says which (issue 21, item 5).
+mkdir -p ref-folder && : > ref-empty.toml
+for ref in ref-folder ref-empty.toml; do
+  sed "s#^source = \"one-dimensional elastic wave theory\"#&\nelements = \"$PWD/$ref\"#" "$bar" > bar-$ref.toml
+done
+expect 2 "a folder as the element reference" -- "$gpa" check bar-ref-folder.toml
+grep -q "reference.elements: .*ref-folder: is a folder, not an element reference file" err.txt || fail "folder as reference: $(cat err.txt)"
+expect 2 "an empty file as the element reference" -- "$gpa" check bar-ref-empty.toml.toml
+grep -q "reference.elements: .*ref-empty.toml: the file is empty" err.txt || fail "empty reference: $(cat err.txt)"
+#    A reference of bytes the TOML parser must not see (a non-ASCII character after a quote in a
+#    bare value: undefined behaviour in toml++ 3.3.0) goes through the scene's guard (issue 21, item 6).
+printf 'scene = "x"\nkind = 2"\317\273"\n' > ref-bytes.toml
+sed "s#^source = \"one-dimensional elastic wave theory\"#&\nelements = \"$PWD/ref-bytes.toml\"#" "$bar" > bar-ref-bytes.toml
+expect 2 "a reference the TOML parser must not see" -- "$gpa" check bar-ref-bytes.toml
+grep -q "ref-bytes.toml:2: a non-ASCII character outside a quoted string" err.txt || fail "reference bytes: $(cat err.txt)"
 #    A relative reference is found beside the scene file, whatever the working folder (as the
 #    scenes in scenes/ name theirs), by run and study alike.
 mkdir -p sub/references && cp ref.toml sub/references/bar.elements.toml

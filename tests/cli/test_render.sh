@@ -69,6 +69,7 @@ refused "component 2D runs lack" "x and z" run --field velocity:y
 refused "size not WxH" "--size 'big'" run --size big
 refused "size too small" "the width must be 200 to 8192" run --size 0x0
 refused "width too large" "--width 100000" run --width 100000
+refused "width zero" "--width 0: it must be 200 to 8192" run --width 0
 refused "size and width" "excludes" run --size 800x600 --width 800
 refused "snapshot out of range" "--snapshot 9" run --snapshot 9
 refused "snapshot not a number" "--snapshot 'first'" run --snapshot first
@@ -98,6 +99,18 @@ refused "truncated vtp" "broken/particles_00001.vtp" broken
 grep -q "cut short" err.txt || fail "truncated vtp: message does not say it is cut short: $(cat err.txt)"
 rm broken/particles_00001.vtp
 refused "snapshot file gone" "particles_00001.vtp: no such file (listed in" broken
+# A snapshot of random bytes, and one of XML with raw bytes in its names: the message says what is
+# wrong and shows no raw byte (only printable ASCII on stderr).
+LC_ALL=C awk 'BEGIN { srand(21); for (i = 0; i < 3000; i++) printf "%c", int(rand() * 256) }' > broken/particles_00001.vtp
+refused "vtp of random bytes" "broken/particles_00001.vtp: not a VTK XML file" broken
+LC_ALL=C grep -q '[^[:print:]]' err.txt && fail "vtp of random bytes: the message shows raw bytes: $(od -c err.txt | head -5)"
+printf '<?xml version="1.0"?>\n<VTKFile type="PolyData"><Pi\317\273\001 /a\002=x>' > broken/particles_00001.vtp
+refused "vtp with raw bytes in its XML" "broken/particles_00001.vtp: malformed XML" broken
+LC_ALL=C grep -q '[^[:print:]]' err.txt && fail "vtp with raw bytes in its XML: the message shows raw bytes: $(od -c err.txt | head -5)"
+# The run's scene.toml, read for its geometry, goes through the scene's guard (issue 21, item 6).
+cp -r run bytes-run
+printf 'geometry = 2"\317\273"\n' > bytes-run/scene.toml
+refused "scene.toml the TOML parser must not see" "bytes-run/scene.toml:1: a non-ASCII character outside a quoted string" bytes-run
 expect 0 "another snapshot of the broken folder still renders" -- "$gpa" render broken --snapshot 0 -o zero.png -q
 
 echo "$failures failure(s)"

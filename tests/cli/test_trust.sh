@@ -189,6 +189,12 @@ cmp -s pulled-whole/history.csv pulled-killed/history.csv || fail "pulled: the r
 # What cannot be resumed is refused.
 expect 2 "resume a finished run" -- "$gpa" run --resume whole -q
 says err.txt "has finished" "resume a finished run"
+mkdir -p empty-run
+expect 2 "resume an empty folder" -- "$gpa" run --resume empty-run -q
+says err.txt "'empty-run' is empty: there is nothing to resume" "resume an empty folder"
+mkdir -p empty-partial.partial
+expect 2 "resume an empty DIR.partial" -- "$gpa" run --resume empty-partial -q
+says err.txt "'empty-partial.partial' is empty: there is nothing to resume" "resume an empty DIR.partial"
 "$gpa" run long.toml -o other -q > /dev/null 2>&1 &
 pid=$!
 wait_for_lines other.partial/history.csv 30
@@ -196,7 +202,75 @@ kill -INT $pid; wait $pid
 expect 2 "resume with another scene" -- "$gpa" run --resume other "$tiny" -q
 says err.txt "is not the scene the run in" "resume with another scene"
 expect 2 "resume with -o" -- "$gpa" run --resume other -o elsewhere -q
+# A new run on the folder of a stopped run that can be resumed is refused, naming --resume and
+# --overwrite, and the stopped run is left as it was (issue 21, item 1); also when the new run
+# would have been refused anyway (here: more disk than there is), which once deleted it first.
+listing() { (cd "$1" && find . -type f | sort | xargs md5sum); }
+listing other.partial > other.before
+expect 2 "new run over a resumable run" -- "$gpa" run long.toml -o other -q
+says err.txt "gpa run --resume other" "new run over a resumable run"
+says err.txt "--overwrite" "new run over a resumable run"
+listing other.partial | cmp -s - other.before || fail "a refused new run changed other.partial"
+variant huge.toml -e 's/^max_steps = 20/end_time = "1 s"/' -e 's/^snapshots = 3/snapshot_interval = "1 ns"/'
+expect 2 "a run needing too much disk over a resumable run" -- "$gpa" run huge.toml -o other -q
+says err.txt "gpa run --resume other" "a run needing too much disk over a resumable run"
+listing other.partial | cmp -s - other.before || fail "a run refused for its disk estimate changed other.partial"
+cp -a other.partial replaced.partial
+expect 0 "--overwrite replaces a resumable run" -- "$gpa" run "$tiny" -o replaced -q --overwrite
+[[ -e replaced.partial ]] && fail "--overwrite left replaced.partial"
+grep -q '"scene": "tiny"' replaced/summary.json 2> /dev/null || fail "--overwrite: the new run's summary: $(head -c 300 replaced/summary.json)"
 expect 0 "resume with its own scene named" -- "$gpa" run --resume other long.toml -q
+
+# Element bodies cannot be checkpointed yet (issue 21, item 4, its messages): check says so, and
+# SIGINT does not promise a checkpoint or a resume that then fails; resume says why there is none.
+variant el.toml -e 's/^max_steps = 20/max_steps = 40000/' -e 's/^spacing = "0.25 mm"/&\ndiscretisation = "elements"/'
+expect 0 "check an element scene" -- "$gpa" check el.toml
+says out.txt "element bodies cannot be checkpointed yet" "check an element scene"
+"$gpa" run el.toml -o el -q > /dev/null 2> el.err &
+pid=$!
+wait_for_lines el.partial/history.csv 30 || fail "el: the run never got going"
+kill -INT $pid; wait $pid; code=$?
+[[ $code -eq 130 ]] || fail "el: exit $code after SIGINT, expected 130 ($(cat el.err))"
+grep -q "checkpoint follow\|resume it with" el.err && fail "el: SIGINT promises a checkpoint or a resume: $(cat el.err)"
+says el.err "element bodies cannot be checkpointed yet, so it cannot be resumed" "el: SIGINT"
+expect 2 "resume an element run" -- "$gpa" run --resume el -q
+says err.txt "its scene has element bodies, which cannot be checkpointed yet" "resume an element run"
+
+# Resume checks what it keeps (issue 21, item 2), each on a copy of one stopped run; a refusal
+# names the file and leaves the folder as it was. (Rows written after the checkpoint are cut back:
+# the kill -9 resumes above.)
+variant slower.toml -e 's/^max_steps = 20/max_steps = 4000/' -e 's/^snapshots = 3/snapshot_interval = "5 us"/' -e 's/"-50 m\/s"/"-40 m\/s"/'
+for scene in long slower; do
+  "$gpa" run $scene.toml -o stopped-$scene -q > /dev/null 2>&1 &
+  pid=$!
+  wait_for_lines stopped-$scene.partial/history.csv 30 || fail "stopped-$scene: the run never got going"
+  kill -INT $pid; wait $pid
+done
+refused_resume() {
+  local dir=$1 what=$2; shift 2
+  listing "$dir.partial" > "$dir.before"
+  expect 2 "$what" -- "$gpa" run --resume "$dir" -q
+  for fragment in "$@"; do says err.txt "$fragment" "$what"; done
+  listing "$dir.partial" | cmp -s - "$dir.before" || fail "$what: the refusal changed $dir.partial"
+  [[ -e $dir ]] && fail "$what: the refused resume made $dir"
+}
+cp -a stopped-long.partial cut.partial
+head -n 10 stopped-long.partial/history.csv > cut.partial/history.csv
+refused_resume cut "history cut before the checkpoint" "'cut.partial/history.csv' has been cut short"
+cp -a stopped-long.partial gone.partial
+rm gone.partial/particles_00000.vtp
+refused_resume gone "a listed snapshot deleted" "'gone.partial/particles_00000.vtp' is missing"
+cp -a stopped-long.partial torn.partial
+head -c 2000 stopped-long.partial/particles_00000.vtp > torn.partial/particles_00000.vtp
+refused_resume torn "a listed snapshot cut short" "'torn.partial/particles_00000.vtp' is not whole"
+cp -a stopped-long.partial mixed.partial
+cp stopped-slower.partial/scene.toml mixed.partial/
+refused_resume mixed "scene.toml of another run" "'mixed.partial/checkpoint.gpack' and 'mixed.partial/scene.toml' are not of the same run"
+cp -a stopped-long.partial swapped.partial
+cp stopped-slower.partial/scene.toml stopped-slower.partial/checkpoint.gpack swapped.partial/
+refused_resume swapped "checkpoint and scene.toml of another run" "'swapped.partial/history.csv'" "'swapped.partial/checkpoint.gpack'"
+expect 0 "the stopped run itself resumes" -- "$gpa" run --resume stopped-long -q
+same_as_whole stopped-long "stopped-long resumed"
 
 # --- a full disk -----------------------------------------------------------------------------
 if [[ $(id -u) -eq 0 ]] && mkdir -p small && mount -t tmpfs -o size=1m tmpfs small 2> /dev/null; then
@@ -227,6 +301,34 @@ if [[ $(id -u) -eq 0 ]] && mkdir -p small && mount -t tmpfs -o size=1m tmpfs sma
   says err.txt "of disk" "disk estimate"
   [[ -e tiny-disk/many.partial ]] && fail "the disk refusal left its folder"
   umount tiny-disk
+  # Resume needs room only for what the rest of the run adds (issue 21, item 3): 121 snapshots of
+  # 15 kB in all, stopped by SIGINT after step 8000 of 12000, then 1.1 MB left free, more than the
+  # last 41 snapshots take but less than all of them. A first resume with too little room is
+  # refused and leaves the run resumable: the second one, with room, continues it as if it had
+  # never stopped (the row of the interruption is off the history's schedule, and goes).
+  mkdir -p room && mount -t tmpfs -o size=4m tmpfs room
+  trap 'umount "$work/room" 2> /dev/null' EXIT
+  variant room.toml -e 's/^max_steps = 20/max_steps = 12000/' \
+    -e 's/^snapshots = 3/snapshot_interval = "1.5 us"\nhistory_every = 100\ncheckpoint_every = 8000/'
+  expect 0 "room: whole" -- "$gpa" run room.toml -o room-whole -q --threads 1
+  "$gpa" run room.toml -o room/run -q --threads 1 > /dev/null 2>&1 &
+  pid=$!
+  wait_for_file room/run.partial/checkpoint.gpack || fail "room: no checkpoint"
+  kill -INT $pid; wait $pid
+  avail=$(df -B1 --output=avail room | tail -1)
+  dd if=/dev/zero of=room/filler bs=1k count=$(( (avail - 100000) / 1024 )) 2> /dev/null
+  expect 2 "resume without room for the rest of the run" -- "$gpa" run --resume room/run -q --threads 1
+  says err.txt "the outputs the rest of the resumed run adds need" "resume without room"
+  rm room/filler
+  avail=$(df -B1 --output=avail room | tail -1)
+  dd if=/dev/zero of=room/filler bs=1k count=$(( (avail - 1100000) / 1024 )) 2> /dev/null
+  expect 0 "resume with room for the rest of the run" -- "$gpa" run --resume room/run -q --threads 1
+  if [[ -d room/run ]]; then
+    for f in room-whole/particles_*.vtp room-whole/history.csv room-whole/particles.pvd; do
+      cmp -s "$f" "room/run/$(basename "$f")" || fail "room: resumed $(basename "$f") differs from the uninterrupted run's"
+    done
+  fi
+  umount room
   trap - EXIT
 else
   echo "SKIP: full-disk cases need root and tmpfs (the gtest DiskFull cases inject the failure instead)"

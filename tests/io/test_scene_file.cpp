@@ -415,6 +415,45 @@ cfl = 1.5
     EXPECT_EQ(error_of(cfl, "cfl.toml"), "cfl.toml: solver.cfl = 1.5 is outside (0, 1]");
 }
 
+// A quote inside a bare value (2", 1.", -', a date or time followed by a quote) does not open a
+// string for toml++, which tests the characters after it against its Unicode tables (where
+// toml++ 3.3.0 reaches __builtin_unreachable for some of them): the guard reads the quote as
+// toml++ does and refuses the non-ASCII character itself, in a value, an array and an inline table.
+TEST(SceneFile, NonAsciiAfterAQuoteInABareValueIsRefusedBeforeTomlReadsIt) {
+    for (const std::string value : {"2\"\xCF\xBB\"", "2.\"\xCF\xBB\"", "-'\xCF\xBB'", "+\"\"\"\xCF\xBB\"\"\"", "1e5\"\xC2\xA0\"",
+                                    "1979-05-27'\xCF\xBB'", "07:32:00\"\xCF\xBB\"", "[1.\"\xCF\xBB\"]", "{ a = 2\"\xCF\xBB\" }"}) {
+        const std::string m = error_of(minimal_head + "name = " + value + "\n");
+        EXPECT_NE(m.find("a non-ASCII character outside a quoted string"), std::string::npos) << value << ": " << m;
+    }
+}
+
+// Non-ASCII text where TOML allows it still reads: strings, quoted keys (dotted too), comments.
+TEST(SceneFile, NonAsciiInStringsQuotedKeysAndCommentsReads) {
+    const Scene s = parse_scene(R"toml(name = 'café ϻ'  # été
+description = """bar é
+   """
+)toml" + minimal_head + elastic_material + R"toml(
+[[body]]
+name = "bär"
+shape = "rectangle"
+material = "rubber"
+origin = [0, 0]
+size = [0.01, 0.01]
+spacing = 0.001
+[reference]
+source = "Müller (2020)"
+"elements" = "e.toml"
+)toml", "scene.toml");
+    EXPECT_EQ(s.name, "café ϻ");
+    EXPECT_EQ(s.bodies.at(0).name, "bär");
+    EXPECT_EQ(s.reference_source, "Müller (2020)");
+    // A quoted part of a dotted key reads as a key (the scene, which has no body, is refused by
+    // the reader, not by the guard or as a syntax error).
+    const std::string m = error_of(minimal_head + "[reference]\na.\"ü\" = 1\n");
+    EXPECT_EQ(m.find("non-ASCII"), std::string::npos) << m;
+    EXPECT_EQ(m.find("syntax error"), std::string::npos) << m;
+}
+
 TEST(SceneFile, QuotedTextCannotBreakTheMessageLine) {
     const std::string m = error_of(minimal_head + "[[body]]\nname = \"two\\nlines\"\nshape = \"cube\"\n");
     EXPECT_EQ(m.find('\n'), std::string::npos) << m;

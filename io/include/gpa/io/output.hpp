@@ -3,6 +3,7 @@
 // history of global quantities, and a JSON summary. The folder is written as DIR.partial and
 // renamed to DIR when the run ends, so that a folder named DIR is always a finished run.
 
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <functional>
@@ -11,6 +12,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "gpa/engine/simulation.hpp"
@@ -20,10 +22,17 @@
 
 namespace gpa::io {
 
+// The checkpoint a stopped run leaves in its folder.partial: while it is there, the run can be
+// resumed (gpa run --resume).
+inline constexpr const char* checkpoint_file_name = "checkpoint.gpack";
+
 class RunFolder {
 public:
     // Fresh: refuses an existing, non-empty `folder` unless overwrite is set (OutputError naming
     // it); clears a stale `folder.partial` left by an earlier failed run and creates a fresh one.
+    // A `folder.partial` that holds a checkpoint (a run that can be resumed) is cleared only
+    // when overwrite is set; otherwise OutputError naming --resume and --overwrite, and the
+    // folder is left as it is.
     // Resume: `folder` (or `folder.partial`) names a run that was stopped; its folder.partial
     // must exist and is kept as it is.
     // Either way the folder's lock (folder.lock, FolderLock) is taken first and held until the
@@ -48,26 +57,45 @@ private:
 // before it and reported as OutputError, so the file always ends with a complete line.
 class HistoryWriter {
 public:
+    // How far the file had got when a checkpoint was written: its length and the digest of those
+    // bytes (bytes == 0: not recorded, as in checkpoints written before it was).
+    struct Mark {
+        long long bytes = 0;
+        std::uint64_t digest = 0;
+    };
     HistoryWriter(const std::filesystem::path& file, const Totals& first, int dim);
-    // For a resumed run: keeps the header and the rows whose step `keep` accepts (the file is
-    // rewritten atomically) and appends after them. OutputError when the file is missing or its
-    // header is not the one this run writes.
-    HistoryWriter(const std::filesystem::path& file, const Totals& first, int dim,
-                  const std::function<bool(std::size_t step)>& keep);
+    // For a resumed run from a checkpoint at step `last_step`, what of the file it keeps: the
+    // file as it was at the checkpoint (its first at.bytes bytes, which must have the recorded
+    // digest; what follows goes) with the rows of steps 0, every, 2 every, ... up to last_step,
+    // which must all be there. Reads the file and changes nothing: OutputError naming the file
+    // (and `checkpoint`) when it is missing, its header is not the one this run writes, it is
+    // shorter than at the checkpoint, it differs from the one the checkpoint recorded, or a row
+    // is missing.
+    static std::string kept_for_resume(const std::filesystem::path& file, const Totals& first, int dim, std::size_t last_step,
+                                       std::size_t every, Mark at, const std::string& checkpoint);
+    // A resumed run: the file rewritten (atomically) to `kept` (kept_for_resume), and appended to.
+    HistoryWriter(const std::filesystem::path& file, const Totals& first, int dim, const std::string& kept);
     ~HistoryWriter();
     HistoryWriter(const HistoryWriter&) = delete;
     HistoryWriter& operator=(const HistoryWriter&) = delete;
     void write(const Totals& t);
+    // The file as it is now (for the checkpoint).
+    Mark mark() const { return {size_, digest_}; }
 
 private:
     void append(const std::string& text);
     int fd_ = -1;
     long long size_ = 0;  // bytes of whole lines in the file
+    std::uint64_t digest_ = 14695981039346656037ull;  // history_digest of those bytes (of none so far)
     std::filesystem::path path_;
     int dim_;
     std::size_t planes_;
     std::vector<std::array<bool, 3>> regions_;  // the held components of each prescribed-velocity region
 };
+
+// The digest a history Mark records (64-bit FNV-1a), carried on from `digest` over `bytes`;
+// history_digest({}) is the digest of nothing.
+std::uint64_t history_digest(std::string_view bytes, std::uint64_t digest = 14695981039346656037ull);
 
 // What one snapshot shows, copied out of a run so that it can be written while the run goes on:
 // the real particle nodes and the element bodies.
