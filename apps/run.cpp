@@ -370,7 +370,9 @@ public:
             const std::string name = entry.path().filename().string();
             const bool kept = std::any_of(state_.snapshots.begin(), state_.snapshots.end(),
                                           [&](const io::PvdEntry& e) { return e.file == name; });
-            const bool snapshot = name.rfind("particles_", 0) == 0 && entry.path().extension() == ".vtp";
+            // Particle snapshots and, for element bodies, the element part of each snapshot.
+            const bool snapshot = (name.rfind("particles_", 0) == 0 && entry.path().extension() == ".vtp") ||
+                                  (name.rfind("elements_", 0) == 0 && entry.path().extension() == ".vtu");
             const bool stale = name == "summary.json" || name == "profile.csv" || entry.path().extension() == ".tmp";
             if ((snapshot && !kept) || stale) fs::remove(entry.path(), ec);
         }
@@ -390,7 +392,7 @@ public:
         const Scene& scene = sim_.scene();
         const std::size_t every = std::max<std::size_t>(scene.output.history_every, 1);
         Progress progress(options_.quiet);
-        StopRequests stop(sim_.can_checkpoint());
+        StopRequests stop;
         auto last_checkpoint = std::chrono::steady_clock::now();
         int stop_signal = 0;
         try {
@@ -437,7 +439,6 @@ private:
     }
 
     void write_checkpoint(double wall_seconds) {
-        if (!sim_.can_checkpoint()) return;  // element bodies: said once at the start
         snapshots_.wait();  // the series on disk is the one the checkpoint lists
         RunState s = state_;
         s.scene_file = source_.label;
@@ -504,7 +505,6 @@ private:
         }
         std::string next;
         if (!problem.empty()) next = fmt::format(", and saving it failed: {}", problem);
-        else if (!sim_.can_checkpoint()) next = "; element bodies cannot be checkpointed yet, so it cannot be resumed: start it again";
         else next = fmt::format("; resume it with: gpa run --resume {}", folder_.final_path().string());
         fmt::print(stderr, "gpa: the run was stopped by {} after step {} at t = {:.4g} us{}\n", name, sim_.steps(), sim_.time() * 1e6, next);
         return 128 + signo;
@@ -568,9 +568,6 @@ int fresh_run(const RunOptions& options) {
         spdlog::info("{}: {} nodes, {} thread{}, output in {}", scene.name.empty() ? "scene" : scene.name, sim.real_count(),
                      sim.threads(), sim.threads() == 1 ? "" : "s", folder.partial().string());
     }
-    if (!sim.can_checkpoint()) {
-        spdlog::warn("element bodies cannot be checkpointed yet: this run writes no checkpoint and cannot be resumed");
-    }
     RunState state;
     state.scene_file = source.label;
     state.overwrite = options.overwrite;
@@ -594,20 +591,6 @@ int resumed_run(const RunOptions& options) {
         std::error_code ec;
         if (fs::is_empty(folder.partial(), ec)) {
             throw io::OutputError(fmt::format("'{}' is empty: there is nothing to resume", folder.partial().string()));
-        }
-        // A run of element bodies never writes one: say so rather than blame checkpoint_every.
-        bool elements = false;
-        try {
-            const Scene copied = io::parse_scene(io::read_scene_text(folder.partial() / scene_copy_name), scene_copy_name);
-            elements = std::any_of(copied.bodies.begin(), copied.bodies.end(),
-                                   [](const BodySpec& b) { return b.discretisation == Discretisation::Elements; });
-        } catch (const std::exception&) {
-            // No readable copy: the message below stands.
-        }
-        if (elements) {
-            throw io::OutputError(fmt::format("'{}' holds no checkpoint: its scene has element bodies, which cannot be checkpointed "
-                                              "yet, so the run cannot be resumed: start it again",
-                                              folder.partial().string()));
         }
         throw io::OutputError(fmt::format("'{}' holds no checkpoint: the run stopped before it wrote one (output.checkpoint_every); "
                                           "start it again",
@@ -696,10 +679,6 @@ int check_scene(const fs::path& file, const MemoryLimit& memory) {
                    r.ramp > 0.0 ? fmt::format(" after a {:.4g} us ramp", r.ramp * 1e6) : std::string());
     }
     fmt::print("  first time step {:.3g} ns; phases: {}\n", sim.next_time_step() * 1e9, fmt::join(sim.phases(), ", "));
-    if (!sim.can_checkpoint()) {
-        fmt::print("  no checkpoints (checkpoint_every does not apply): element bodies cannot be checkpointed yet, so an "
-                   "interrupted run of this scene cannot be resumed\n");
-    }
     return 0;
 }
 

@@ -7,9 +7,8 @@ namespace gpa::app {
 
 class StopRequests {
 public:
-    // Installs the handlers; the destructor puts back the ones that were there. `checkpoint`:
-    // whether the stop writes a checkpoint (the message on the terminal says so, or not).
-    explicit StopRequests(bool checkpoint = true);
+    // Installs the handlers; the destructor puts back the ones that were there.
+    StopRequests();
     ~StopRequests();
     StopRequests(const StopRequests&) = delete;
     StopRequests& operator=(const StopRequests&) = delete;

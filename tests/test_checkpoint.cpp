@@ -10,6 +10,7 @@
 
 #include <gtest/gtest.h>
 
+#include "gpa/engine/elements.hpp"
 #include "gpa/engine/errors.hpp"
 #include "gpa/engine/simulation.hpp"
 #include "gpa/engine/state_io.hpp"
@@ -218,6 +219,64 @@ TEST(Checkpoint, EveryPartRestoresItsOwnSectionExactly) {
     }
 }
 
+// The state of a run's element bodies as the checkpoint encodes it (ElementPart::write_state).
+std::string element_bytes(const Simulation& sim) {
+    std::ostringstream out;
+    StateWriter w(out);
+    sim.elements()->write_state(w);
+    return out.str();
+}
+
+Scene with_element_bodies(Scene scene) {
+    for (auto& b : scene.bodies) {
+        b.discretisation = Discretisation::Elements;
+        b.connectivity.reset();
+        b.lattice_neighbours = 0;
+    }
+    scene.stop = {};
+    scene.stop.max_steps = 100000;
+    return scene;
+}
+
+TEST(Checkpoint, AnElementRunResumesBitIdenticallyOnOneAndTwoThreads) {
+    // Element bodies (elements.hpp) checkpoint their own section: a run stopped and resumed, on
+    // another thread count, ends with every element field and every total identical byte for
+    // byte to a run never stopped. The bar bounces on a lift-off plane (plane contacts come and go,
+    // reactions and impulses); the pulled bar holds element nodes in prescribed regions.
+    struct ElementCase {
+        const char* name;
+        Scene scene;
+        int stop_at, steps;
+    };
+    const std::vector<ElementCase> element_cases{
+        {"element bar on a lift-off plane", with_element_bodies(testing::elastic_bar_on_plane(1e-3, 12e-3, 6, 100.0)), 150, 260},
+        {"pulled element bar with a grip and a clamp",
+         with_element_bodies(testing::pulled_elastic_bar(GeometryKind::Axisymmetric, 1e-3, 10e-3, 6, 5.0, 0.2e-6, 0.3)), 60, 120},
+    };
+    for (const auto& c : element_cases) {
+        SCOPED_TRACE(c.name);
+        for (const auto& [first, second] : std::vector<std::pair<int, int>>{{1, 2}, {2, 1}}) {
+            SCOPED_TRACE(::testing::Message() << "stopped on " << first << " thread(s), resumed on " << second);
+            Simulation never_stopped(c.scene, first);
+            ASSERT_NE(never_stopped.elements(), nullptr);
+            ASSERT_TRUE(never_stopped.can_checkpoint());
+            for (int k = 0; k < c.stop_at; ++k) never_stopped.step();
+            const std::string saved = checkpoint_of(never_stopped);
+            Simulation resumed(c.scene, second);
+            restore(resumed, saved);
+            ASSERT_EQ(resumed.steps(), static_cast<std::size_t>(c.stop_at));
+            EXPECT_TRUE(element_bytes(never_stopped) == element_bytes(resumed)) << "element state differs right after the restore";
+            for (int k = c.stop_at; k < c.steps; ++k) never_stopped.step();
+            for (int k = c.stop_at; k < c.steps; ++k) resumed.step();
+            EXPECT_TRUE(element_bytes(never_stopped) == element_bytes(resumed)) << "element state differs after " << c.steps << " steps";
+            EXPECT_TRUE(totals_bytes(never_stopped.totals()) == totals_bytes(resumed.totals()));
+            EXPECT_EQ(never_stopped.element_steps(), resumed.element_steps());
+            // The run moved: the comparison is not of two states at rest.
+            EXPECT_GT(never_stopped.totals().kinetic_energy, 0.0);
+        }
+    }
+}
+
 TEST(Checkpoint, WritingOneChangesNothing) {
     // A run that writes checkpoints is the run that does not: save_checkpoint only reads.
     const auto scene = testing::armco_cylinder(12, 40e-6);
@@ -299,6 +358,18 @@ TEST(Checkpoint, DamagedOnesAreRefusedAndLeaveTheSimulationUnusable) {
     Simulation other(testing::armco_cylinder(10, 40e-6), 1);
     m = refusal([&] { restore(other, saved); });
     EXPECT_NE(m.find("nodes"), std::string::npos) << m;
+}
+
+TEST(Checkpoint, AnElementCheckpointOfAnotherMeshIsRefused) {
+    // The mesh comes from the scene; a checkpoint of a mesh of another size is refused by name.
+    const auto coarse = with_element_bodies(testing::elastic_bar_on_plane(1e-3, 12e-3, 6, 100.0));
+    const auto fine = with_element_bodies(testing::elastic_bar_on_plane(1e-3, 12e-3, 8, 100.0));
+    Simulation a(coarse, 1);
+    for (int k = 0; k < 5; ++k) a.step();
+    const std::string saved = checkpoint_of(a);
+    Simulation b(fine, 1);
+    const std::string message = refusal([&] { restore(b, saved); });
+    EXPECT_NE(message.find("its element mesh has"), std::string::npos) << message;
 }
 
 }  // namespace

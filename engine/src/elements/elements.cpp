@@ -383,6 +383,70 @@ ElementPart::ElementPart(const Scene& scene, ElementMesh mesh, ElementOptions op
 
 ElementPart::~ElementPart() = default;
 
+namespace {
+
+// The arrays of the element state a checkpoint carries, in one order for writing and reading.
+template <class Mesh, class F>
+void for_each_state_array(Mesh& m, F&& f) {
+    for (int c = 0; c < 2; ++c) {
+        f(m.nodes.position[c]);
+        f(m.nodes.velocity[c]);
+        f(m.nodes.force[c]);
+    }
+    f(m.nodes.held);
+    f(m.nodes.contact);
+    f(m.quads.volume);
+    f(m.quads.length);
+    f(m.quads.rate);
+    for (auto& s : m.points.deviatoric_stress) f(s);
+    f(m.points.pressure);
+    f(m.points.viscous_pressure);
+    f(m.points.sound_speed);
+    f(m.points.internal_energy);
+    f(m.points.temperature);
+    f(m.points.plastic_strain);
+    f(m.points.damage);
+    f(m.points.plastic_work);
+    f(m.points.viscous_work);
+    f(m.points.failed);
+    f(m.points.density);
+    f(m.points.volume);
+    for (auto& l : m.points.velocity_gradient) f(l);
+}
+
+}  // namespace
+
+void ElementPart::write_state(StateWriter& out) const {
+    out.tag("ELEM");
+    out.value<std::uint64_t>(mesh_.nodes.size());
+    out.value<std::uint64_t>(mesh_.quads.size());
+    out.value<std::uint64_t>(mesh_.points.size());
+    for_each_state_array(mesh_, [&](const auto& v) { out.array(v); });
+    out.array(reaction_);
+    out.array(impulse_);
+    out.value<double>(boundary_work_);
+}
+
+void ElementPart::read_state(StateReader& in) {
+    in.tag("ELEM");
+    const auto nodes = in.value<std::uint64_t>();
+    const auto quads = in.value<std::uint64_t>();
+    const auto points = in.value<std::uint64_t>();
+    if (nodes != mesh_.nodes.size() || quads != mesh_.quads.size() || points != mesh_.points.size()) {
+        in.fail(fmt::format("its element mesh has {} nodes, {} quadrilaterals and {} triangles; this scene's has {}, {} and {}", nodes,
+                            quads, points, mesh_.nodes.size(), mesh_.quads.size(), mesh_.points.size()));
+    }
+    for_each_state_array(mesh_, [&](auto& v) {
+        const std::size_t expected = v.size();
+        in.array(v);
+        if (v.size() != expected) in.fail("an element array has another length than this scene's mesh (a damaged checkpoint)");
+    });
+    in.array(reaction_);
+    in.array(impulse_);
+    if (reaction_.size() != rigid_planes_.size() || impulse_.size() != rigid_planes_.size()) in.fail("its planes are not the scene's");
+    boundary_work_ = in.value<double>();
+}
+
 double ElementPart::face_tolerance(std::size_t node) const {
     return measure::element_face_tolerance(mesh_.body_spacing[static_cast<std::size_t>(mesh_.nodes.body[node])]);
 }

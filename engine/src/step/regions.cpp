@@ -151,7 +151,9 @@ void Regions::check_restored(StateReader& in, const NodeStore& nodes, std::size_
     }
     index(nodes, real);
     for (std::size_t k = 0; k < regions; ++k) {
-        if (held_particles_.nodes().row_size(k) != node_count_[k]) in.fail("its prescribed velocities hold other nodes than the scene's");
+        // (Element nodes are held by their set-up positions, which the mesh keeps; particles move.)
+        const std::size_t held = held_particles_.nodes().row_size(k) + (held_elements_.empty() ? 0 : held_elements_.nodes().row_size(k));
+        if (held != node_count_[k]) in.fail("its prescribed velocities hold other nodes than the scene's");
     }
 }
 

@@ -732,6 +732,7 @@ void Simulation::Impl::write_state(StateWriter& out) const {
     out.value<double>(dt_next);
     out.value<std::uint64_t>(steps);
     out.value<double>(node_steps);
+    out.value<double>(element_steps);
     out.value<std::uint64_t>(totals.bodies.size());
     for (const auto& b : totals.bodies) out.value<double>(b.kinetic_energy);
     out.array(impulse);
@@ -739,6 +740,7 @@ void Simulation::Impl::write_state(StateWriter& out) const {
     measures.write_state(out);
     ledger.write_state(out);
     regions.write_state(out);
+    if (elements) elements->write_state(out);
     out.tag("TOTL");
     const Totals& t = totals;
     for (const double v : {t.time, t.time_step, t.kinetic_energy, t.internal_energy, t.plastic_work, t.viscous_work,
@@ -791,6 +793,7 @@ void Simulation::Impl::read_state(StateReader& in) {
     dt_next = in.value<double>();
     steps = static_cast<std::size_t>(in.value<std::uint64_t>());
     node_steps = in.value<double>();
+    element_steps = in.value<double>();
     std::vector<double> body_kinetic(static_cast<std::size_t>(in.value<std::uint64_t>()));
     if (body_kinetic.size() != scene.bodies.size()) in.fail("its bodies are not the scene's");
     for (double& k : body_kinetic) k = in.value<double>();
@@ -800,6 +803,7 @@ void Simulation::Impl::read_state(StateReader& in) {
     if (impulse.size() != rigid_planes.size() || reaction.size() != rigid_planes.size()) in.fail("its planes are not the scene's");
     ledger.read_state(in);
     regions.read_state(in);
+    if (elements) elements->read_state(in);
     const std::size_t region_count = scene.prescribed_velocities.size();
     in.tag("TOTL");
     Totals& t = totals;
@@ -848,13 +852,9 @@ void Simulation::Impl::read_state(StateReader& in) {
     regions.check_restored(in, nodes, real);
 }
 
-bool Simulation::can_checkpoint() const { return !impl_->elements; }
+bool Simulation::can_checkpoint() const { return true; }
 
 void Simulation::save_checkpoint(std::ostream& out, std::string_view scene_fingerprint, std::string_view user_data) const {
-    if (!can_checkpoint()) {
-        throw InputError("Simulation::save_checkpoint: scenes with element bodies cannot be checkpointed yet (their state is not "
-                         "in the checkpoint format)");
-    }
     if (impl_->failed) throw NumericalError("Simulation::save_checkpoint: the last step failed and left the state half-updated");
     StateWriter w(out);
     w.bytes(checkpoint_magic, sizeof checkpoint_magic);

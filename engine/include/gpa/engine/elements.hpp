@@ -35,6 +35,7 @@
 #include "gpa/engine/colouring.hpp"
 #include "gpa/engine/compressed_rows.hpp"
 #include "gpa/engine/scene.hpp"
+#include "gpa/engine/state_io.hpp"
 
 namespace gpa {
 
@@ -174,6 +175,14 @@ public:
     ElementMesh& mesh() { return mesh_; }
     const ScatterPlan& plan() const { return plan_; }
     const ElementOptions& options() const { return options_; }
+
+    // Checkpoints (Simulation::save_checkpoint): the state later steps depend on, as its own section
+    // (nodes' positions, velocities, forces and plane contacts; the quadrilaterals' volumes, lengths
+    // and rates; every field of every triangle; the planes' reactions and impulses; the boundary
+    // work). The mesh's connectivity, masses and colouring come from the scene, as at the start;
+    // read_state throws CheckpointError when the counts are not those of this mesh.
+    void write_state(StateWriter& out) const;
+    void read_state(StateReader& in);
 
 private:
     template <class G>

@@ -201,8 +201,8 @@ public:
     // identifies the scene to the caller, e.g. a hash of its file) and `user_data` (anything the
     // caller wants back).
     void save_checkpoint(std::ostream& out, std::string_view scene_fingerprint, std::string_view user_data = {}) const;
-    // False for scenes with element bodies: their state is not in the checkpoint format yet, and
-    // save_checkpoint refuses them (InputError) rather than write one that would not resume exactly.
+    // Every scene can be checkpointed, element bodies included (format 5); kept for programs
+    // written against earlier versions, where element scenes could not.
     bool can_checkpoint() const;
     // Restores a checkpoint of `size` bytes (`source` names it in messages) into a Simulation
     // built from the same scene; returns its user_data. Throws CheckpointError, before changing
@@ -213,7 +213,7 @@ public:
     // Reads the header of a checkpoint (no Simulation needed). Throws CheckpointError.
     static CheckpointInfo checkpoint_info(std::istream& in, std::uint64_t size, const std::string& source);
     // The format version save_checkpoint writes.
-    static constexpr std::uint32_t checkpoint_format = 4;  // 4: a section per part of the step (energy ledger, regions)
+    static constexpr std::uint32_t checkpoint_format = 5;  // 4: a section per part of the step; 5: element bodies
 
 private:
     struct Impl;
