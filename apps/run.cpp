@@ -291,6 +291,10 @@ void print_report(const Simulation& sim) {
             if (const auto it = ratios.find("outline_distance"); it != ratios.end()) {
                 line += fmt::format(", outline distance {:.3g} mm", it->second * 1e3);
             }
+            if (line.empty()) {
+                line = "none of its metrics is measured by this run (length and footprint need a rigid plane, the peaks "
+                       "the reference's peak radius)";
+            }
             fmt::print("  against the element reference ({}): {}\n", sim.scene().element_reference, line);
         } catch (const InputError& e) {
             fmt::print("  element reference: {}\n", e.what());

@@ -375,8 +375,13 @@ std::string json_number(double v) { return std::isfinite(v) ? fmt::format("{:.10
 
 std::map<std::string, double> run_metrics(const Simulation& sim) {
     const auto& t = sim.totals();
-    std::map<std::string, double> m{{"final_length", t.length}, {"footprint_diameter", t.footprint_diameter},
-                                    {"plastic_work", t.plastic_work}};
+    std::map<std::string, double> m{{"plastic_work", t.plastic_work}};
+    // Length and footprint are measured above the first rigid plane (measure.hpp): a scene without
+    // one has no such metrics (its totals read 0, which no reference should be divided into).
+    if (!t.planes.empty()) {
+        m["final_length"] = t.length;
+        m["footprint_diameter"] = t.footprint_diameter;
+    }
     if (t.local.measured && t.local.plastic_strain.points > 0) {
         m["peak_plastic_strain"] = t.local.plastic_strain.value;
         m["peak_temperature"] = t.local.temperature.value;

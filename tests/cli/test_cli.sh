@@ -114,6 +114,15 @@ head -1 study-ref/study.csv | grep -q "L_star,D_star,PW_star" || fail "study.csv
 grep -q "Against the element reference" study-ref/study.md || fail "study.md lacks the element reference section"
 expect 0 "run against a reference" -- "$gpa" run bar-ref.toml -o run-ref -q
 grep -q '"element_reference": {"file"' run-ref/summary.json || fail "summary.json lacks the element reference"
+#    The same reference named by a scene without a rigid plane, where length and footprint are not
+#    measured (issue 21, item 5: it reported L* 0.0000): no ratio of a metric the run does not have.
+sed '/^\[\[plane\]\]/,/^lift_off/d' bar-ref.toml > bar-ref-free.toml
+grep -q '^\[\[plane\]\]' bar-ref-free.toml && fail "could not make the scene without a plane"
+expect 0 "run without a plane against a reference" -- "$gpa" run bar-ref-free.toml -o run-ref-free
+grep -q 'L\* \|D\* ' out.txt && fail "a run without a rigid plane reports L* or D*: $(grep 'element reference' out.txt)"
+grep -q 'against the element reference' out.txt || fail "no word on the reference: $(grep -i 'reference' out.txt)"
+grep -q '"final_length": {"reference": [^}]*"computed": null' run-ref-free/summary.json ||
+  fail "summary.json of a run without a plane: $(grep -o '"final_length": {[^}]*}' run-ref-free/summary.json)"
 sed "s#^source = \"one-dimensional elastic wave theory\"#&\nelements = \"no-such-reference.toml\"#" "$bar" > bar-noref.toml
 expect 2 "scene naming a missing reference" -- "$gpa" check bar-noref.toml
 grep -q "reference.elements" err.txt || fail "the message does not name reference.elements: $(cat err.txt)"

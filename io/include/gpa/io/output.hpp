@@ -167,8 +167,9 @@ struct ReferenceComparison {
 };
 std::vector<ReferenceComparison> compare_with_reference(const Simulation& sim);
 
-// The metrics of a run that a reference may state: final_length, footprint_diameter,
-// plastic_work, and peak_plastic_strain, peak_temperature once measure_bodies() has measured them.
+// The metrics of a run that a reference may state: plastic_work; final_length and
+// footprint_diameter when the scene has a rigid plane to measure them on; peak_plastic_strain and
+// peak_temperature once measure_bodies() has measured them.
 std::map<std::string, double> run_metrics(const Simulation& sim);
 
 // The summary's "element_reference" object (JSON) when the scene names an element reference: for
