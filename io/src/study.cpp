@@ -381,7 +381,11 @@ std::string variant_keys_help() {
 }
 
 void apply_variant(const Variant& variant, Scene& scene) {
-    for (const auto& [key, value] : variant.settings) {
+    for (const auto& setting : variant.settings) {
+        // Plain names, not a structured binding: clang 14 (the sanitizer build) refuses lambdas
+        // that capture one.
+        const std::string& key = setting.first;
+        const std::string& value = setting.second;
         if (const auto* option = find_solver_option(key)) {
             detail::read_solver_option_text(*option, value, fmt::format("--variant {}", variant.name), scene.solver);
             // The variant's connectivity holds for every body.
