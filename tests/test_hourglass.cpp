@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <random>
 
 #include <fmt/format.h>
@@ -227,6 +228,82 @@ TEST_P(Hourglass, IsBitIdenticalOnOneAndTwoThreads) {
         EXPECT_EQ(std::memcmp(one.nodes.force[p].data(), two.nodes.force[p].data(), nodes.size() * sizeof(double)), 0);
     }
     EXPECT_EQ(std::memcmp(one.power.data(), two.power.data(), nodes.size() * sizeof(double)), 0);
+}
+
+// The energy booking (compatible update) takes the power of the force pass's control forces at
+// other velocities. It makes them again from the fits the force pass kept (KeptFit) instead of
+// fitting again: the same powers, bit for bit, as a fresh fit gives, for the damping and the
+// stiffness form, with centres that have no control (past the lattice regime) among them.
+TEST_P(Hourglass, TheBookingPassMakesTheSameForcesFromTheKeptFits) {
+    const Case c = GetParam();
+    NodeStore nodes = body(c, 0.0);
+    nodes.initial_position = nodes.position;  // the stiffness form measures against these
+    testing::jitter(nodes, 0.15, 1e-3, 5);
+    testing::randomise_state(nodes, 17);
+    for (auto& s : nodes.sound_speed) s = 5000.0;
+    for (std::size_t i = 0; i < nodes.size(); i += 7) nodes.plastic_strain[i] = 0.5;  // past the 0.1 below
+    const std::size_t n = nodes.size();
+    const int dim = nodes.dim();
+    const auto lists = find_neighbours(nodes, a, n);
+    for (std::size_t i = 0; i < n; ++i) nodes.smallest_h[i] = a * nodes.diameter[i];
+    const PositionView x{dim, {nodes.position[0].data(), nodes.position[1].data(), dim == 3 ? nodes.position[2].data() : nullptr}};
+    const auto plan = make_slab_plan(lists, x);
+    std::mt19937_64 rng(3);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    std::array<std::vector<double>, 3> other;  // the velocities the booking takes the power at
+    for (int p = 0; p < dim; ++p) {
+        other[p].resize(n);
+        for (auto& v : other[p]) v = u(rng);
+    }
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    const auto run = [&]<int D>() {
+        // The kept fits start as NaN: the force pass must write every centre's scale.
+        std::array<std::vector<double>, 1 + D * D> damping_store, stiffness_store;
+        for (auto& v : damping_store) v.assign(n, nan);
+        for (auto& v : stiffness_store) v.assign(n, nan);
+        std::vector<double> damping(n), stiffness(n);
+        auto f = hourglass_fields<D>(nodes, 0.1, damping.data(), 0.05, stiffness.data());
+        f.damping_fit.scale = damping_store[0].data();
+        f.stiffness_fit.scale = stiffness_store[0].data();
+        for (int k = 0; k < D * D; ++k) {
+            f.damping_fit.matrix[k] = damping_store[k + 1].data();
+            f.stiffness_fit.matrix[k] = stiffness_store[k + 1].data();
+        }
+        apply_hourglass_control<D>(lists, plan, f, n, 0.1);
+        for (int c2 = 0; c2 < D; ++c2) {
+            f.force[c2] = nullptr;
+            f.power_velocity[c2] = other[c2].data();
+        }
+        std::size_t kept = 0, without = 0;
+        for (std::size_t i = 0; i < n; ++i) {
+            const bool controlled = nodes.connectivity[i] == Connectivity::Fixed || nodes.plastic_strain[i] < 0.1;
+            if (controlled) {
+                ++kept;
+            } else {
+                ++without;
+                EXPECT_EQ(damping_store[0][i], 0.0) << "centre " << i << " has no control: its scale says so";
+            }
+            auto fresh = f;
+            fresh.use_kept_fits = false;
+            auto reuse = f;
+            reuse.use_kept_fits = true;
+            const HourglassPower a_fresh = hourglass_centre<D>(lists.row(i), i, fresh, n, 0.1);
+            const HourglassPower a_kept = hourglass_centre<D>(lists.row(i), i, reuse, n, 0.1);
+            ASSERT_EQ(std::memcmp(&a_fresh.damping, &a_kept.damping, sizeof(double)), 0)
+                << "centre " << i << ": " << a_fresh.damping << " fitted again, " << a_kept.damping << " from the kept fit";
+            ASSERT_EQ(std::memcmp(&a_fresh.stiffness, &a_kept.stiffness, sizeof(double)), 0)
+                << "centre " << i << ": " << a_fresh.stiffness << " fitted again, " << a_kept.stiffness << " from the kept fit";
+            if (controlled) EXPECT_NE(a_kept.damping, 0.0) << "centre " << i;
+            if (controlled && nodes.connectivity[i] == Connectivity::Fixed) EXPECT_NE(a_kept.stiffness, 0.0) << "centre " << i;
+        }
+        EXPECT_GT(kept, 0u);
+        if (c.connectivity == Connectivity::Variable) EXPECT_GT(without, 0u);
+    };
+    if (dim == 2) {
+        run.template operator()<2>();
+    } else {
+        run.template operator()<3>();
+    }
 }
 
 // Variable nodes are controlled only in the lattice regime (plastic strain below the threshold).

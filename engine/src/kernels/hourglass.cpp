@@ -54,7 +54,16 @@ HourglassPower hourglass_centre(std::span<const NodeIndex> row, std::size_t i, c
     };
     HourglassPower out;
     if (i >= real_count) return out;
-    if (f.connectivity[i] != Connectivity::Fixed && !(f.plastic_strain[i] < f.lattice_plastic_strain)) return out;
+    // The kept fits say 0 for a centre without control (see KeptFit), so that the booking pass
+    // needs no array cleared every step.
+    const auto no_kept_fit = [&](const typename HourglassFields<D>::KeptFit& kept) {
+        if (kept.scale && !f.use_kept_fits) kept.scale[i] = 0.0;
+    };
+    if (f.connectivity[i] != Connectivity::Fixed && !(f.plastic_strain[i] < f.lattice_plastic_strain)) {
+        no_kept_fit(f.damping_fit);
+        no_kept_fit(f.stiffness_fit);
+        return out;
+    }
     // The pairs the control acts on: a centre's real neighbours of its own body (ghosts and other
     // bodies take no part, nor do the pairs of a failed node when those separate).
     const auto controlled_pair = [&](NodeIndex j) {
@@ -87,7 +96,35 @@ HourglassPower hourglass_centre(std::span<const NodeIndex> row, std::size_t i, c
         double weight;  // w = W_j / r^2 (damping) or 1 / |dX|^2 (stiffness)
     };
     thread_local std::vector<Pair> pairs;
-    if (coefficient > 0.0) {
+    const auto keep = [&](const typename HourglassFields<D>::KeptFit& kept, double scale, const Mat<D>& matrix) {
+        if (!kept.scale) return;
+        kept.scale[i] = scale;
+        for (int a = 0; a < D; ++a) {
+            for (int b = 0; b < D; ++b) kept.matrix[a * D + b][i] = matrix(a, b);
+        }
+    };
+    const auto kept_matrix = [&](const typename HourglassFields<D>::KeptFit& kept) {
+        Mat<D> m;
+        for (int a = 0; a < D; ++a) {
+            for (int b = 0; b < D; ++b) m(a, b) = kept.matrix[a * D + b][i];
+        }
+        return m;
+    };
+    if (coefficient > 0.0 && f.use_kept_fits) {
+        // The force pass's fit: its forces again, pair by pair as in pass 2 below, for their power.
+        const double kappa = f.damping_fit.scale[i];
+        if (kappa != 0.0) {
+            const Mat<D> fitted_gradient = kept_matrix(f.damping_fit);
+            for (NodeIndex j : row) {
+                if (!controlled_pair(j)) continue;
+                const Vec<D> r = load(f.position, j) - x_i;
+                const double w = hourglass_pair_weight(f.size_weight[j], r.squaredNorm());
+                const Vec<D> dv = load(f.velocity, j) - v_i;
+                const Vec<D> force_on_j = (-kappa * w) * hourglass_velocity_error<D>(fitted_gradient, r, dv);
+                out.damping += power_of(j, force_on_j, dv);
+            }
+        }
+    } else if (coefficient > 0.0) {
         // Pass 1: the weighted least-squares velocity gradient of the lattice pairs.
         pairs.clear();
         HourglassFit<D> fit;
@@ -99,9 +136,11 @@ HourglassPower hourglass_centre(std::span<const NodeIndex> row, std::size_t i, c
             pairs.push_back({j, r, w});
         }
         Mat<D> inverse;
+        no_kept_fit(f.damping_fit);
         if (invert(fit, inverse)) {
             const Mat<D> fitted_gradient = fit.difference * inverse;
             const double kappa = hourglass_damping(coefficient, f.mass[i], f.sound_speed[i], f.smallest_h[i]) / fit.weight;
+            keep(f.damping_fit, kappa, fitted_gradient);
             // Pass 2: F_j = - kappa w_j e_ij on the neighbour, the reaction on the centre.
             for (const Pair& p : pairs) {
                 const Vec<D> dv = load(f.velocity, p.j) - v_i;
@@ -114,7 +153,20 @@ HourglassPower hourglass_centre(std::span<const NodeIndex> row, std::size_t i, c
             }
         }
     }
-    if (f.stiffness > 0.0 && f.connectivity[i] == Connectivity::Fixed) {
+    if (f.stiffness > 0.0 && f.connectivity[i] == Connectivity::Fixed && f.use_kept_fits) {
+        const double k = f.stiffness_fit.scale[i];
+        if (k != 0.0) {
+            const Vec<D> x0_i = load(f.initial_position, i);
+            const Mat<D> fitted_map = kept_matrix(f.stiffness_fit);
+            for (NodeIndex j : row) {
+                if (!stiff_pair(j)) continue;
+                const Vec<D> initial = load(f.initial_position, j) - x0_i;
+                const double w = hourglass_pair_weight(1.0, initial.squaredNorm());
+                const Vec<D> force_on_j = (-k * w) * hourglass_displacement_error<D>(fitted_map, initial, load(f.position, j) - x_i);
+                out.stiffness += power_of(j, force_on_j, load(f.velocity, j) - v_i);
+            }
+        }
+    } else if (f.stiffness > 0.0 && f.connectivity[i] == Connectivity::Fixed) {
         // The stiffness form (kernels.hpp, hourglass_stiffness): the affine map of the initial
         // lattice pairs that fits their current offsets best, then forces against the rest.
         const Vec<D> x0_i = load(f.initial_position, i);
@@ -128,9 +180,11 @@ HourglassPower hourglass_centre(std::span<const NodeIndex> row, std::size_t i, c
             pairs.push_back({j, initial, w});
         }
         Mat<D> inverse;
+        no_kept_fit(f.stiffness_fit);
         if (invert(fit, inverse)) {
             const Mat<D> fitted_map = fit.difference * inverse;
             const double k = hourglass_stiffness(f.stiffness, f.mass[i], f.sound_speed[i], f.initial_diameter[i]) / fit.weight;
+            keep(f.stiffness_fit, k, fitted_map);
             for (const Pair& p : pairs) {
                 const Vec<D> force_on_j = (-k * p.weight) *
                                           hourglass_displacement_error<D>(fitted_map, p.offset, load(f.position, p.j) - x_i);

@@ -22,11 +22,24 @@ EnergyLedger::EnergyLedger(const SolverOptions& solver)
     : compatible_(solver.energy_update == EnergyUpdate::Compatible),
       bond_(solver.viscosity == ViscosityKind::Bond),
       hourglass_(solver.hourglass_coefficient > 0.0 || solver.hourglass_stiffness > 0.0),
-      stiffness_(solver.hourglass_stiffness > 0.0) {}
+      stiffness_(solver.hourglass_stiffness > 0.0),
+      damping_(solver.hourglass_coefficient > 0.0) {}
 
 double* EnergyLedger::bond_power(std::size_t count) { return zeroed(bond_power_, count); }
 double* EnergyLedger::hourglass_power(std::size_t count) { return zeroed(hourglass_power_, count); }
 double* EnergyLedger::stiffness_power(std::size_t count) { return stiffness_ ? zeroed(stiffness_power_, count) : nullptr; }
+
+template <int D>
+void EnergyLedger::keep_hourglass_fits(HourglassFields<D>& control, std::size_t count) {
+    if (!compatible_) return;
+    const auto point = [count](std::array<std::vector<double>, 10>& store, typename HourglassFields<D>::KeptFit& kept) {
+        for (int k = 0; k <= D * D; ++k) resize_with_slack(store[k], count);
+        kept.scale = store[0].data();
+        for (int k = 0; k < D * D; ++k) kept.matrix[k] = store[k + 1].data();
+    };
+    if (damping_) point(damping_fit_, control.damping_fit);
+    if (stiffness_) point(stiffness_fit_, control.stiffness_fit);
+}
 
 void EnergyLedger::keep_half_step_velocities(const NodeStore& nodes, std::size_t real) {
     if (!(compatible_ && hourglass_)) return;
@@ -72,6 +85,9 @@ void EnergyLedger::compatible_powers(const CompressedRows& lists, WeightKind wei
     // force pass, their power taken at the mean velocities: the kinetic energy they remove in this
     // update).
     if (control) {
+        // The force pass's fits (keep_hourglass_fits), for the same forces without fitting again.
+        keep_hourglass_fits<D>(*control, real);
+        control->use_kept_fits = true;
         control->power = hourglass_power_.data();
         control->stiffness_power = stiffness_ ? stiffness_power_.data() : nullptr;
         for (int c = 0; c < D; ++c) {
@@ -139,6 +155,10 @@ void EnergyLedger::memory_use(MemoryUse& out) const {
     for (const auto& v : mean_velocity_) velocities += allocated_bytes(v);
     for (const auto& v : half_velocity_) velocities += allocated_bytes(v);
     add_memory(out, "energy ledger: mean and half-step velocities", velocities);
+    std::size_t fits = 0;
+    for (const auto& v : damping_fit_) fits += allocated_bytes(v);
+    for (const auto& v : stiffness_fit_) fits += allocated_bytes(v);
+    add_memory(out, "energy ledger: hourglass fits of the force pass", fits);
 }
 
 void EnergyLedger::write_state(StateWriter& out) const {
@@ -168,5 +188,8 @@ template void EnergyLedger::compatible_powers<Axisymmetric>(const CompressedRows
 template void EnergyLedger::compatible_powers<ThreeD>(const CompressedRows&, WeightKind, const ForceFields<3>&,
                                                       std::optional<HourglassFields<3>>, double, NodeStore&, std::size_t, double,
                                                       const HeldNodes&, const std::vector<PrescribedVelocitySpec>&, GhostSet&);
+
+template void EnergyLedger::keep_hourglass_fits<2>(HourglassFields<2>&, std::size_t);
+template void EnergyLedger::keep_hourglass_fits<3>(HourglassFields<3>&, std::size_t);
 
 }  // namespace gpa

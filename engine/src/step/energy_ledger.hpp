@@ -41,6 +41,12 @@ public:
     double* hourglass_power(std::size_t count);
     double* stiffness_power(std::size_t count);  // null without the stiffness form
 
+    // For the force pass: keeps its hourglass fits of `count` centres (hourglass.hpp, KeptFit) in the
+    // ledger's arrays, so that compatible_powers makes the same forces without fitting again. Only
+    // with the compatible update (nothing else reads them).
+    template <int D>
+    void keep_hourglass_fits(HourglassFields<D>& control, std::size_t count);
+
     // Before the velocity update: v^{n+1/2} of the real nodes, from which the force pass made the
     // hourglass forces (their power is taken at the mean velocities later). Only when needed.
     void keep_half_step_velocities(const NodeStore& nodes, std::size_t real);
@@ -77,6 +83,7 @@ private:
     bool bond_ = false;
     bool hourglass_ = false;
     bool stiffness_ = false;
+    bool damping_ = false;  // the hourglass control's damping form (C_hg > 0)
     bool stress_powers_due_ = false;  // compatible_powers ran this step: book the stress work
     double boundary_work_ = 0.0;
     double hourglass_work_ = 0.0;
@@ -85,6 +92,8 @@ private:
     std::vector<double> stress_power_, viscous_power_;                   // per real node
     std::array<std::vector<double>, 3> mean_velocity_;                    // per node, ghosts mirrored
     std::array<std::vector<double>, 3> half_velocity_;                    // per real node
+    // The force pass's hourglass fits per real node: the scale, then the D * D matrix entries.
+    std::array<std::vector<double>, 10> damping_fit_, stiffness_fit_;
 };
 
 }  // namespace gpa

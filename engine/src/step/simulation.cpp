@@ -392,9 +392,9 @@ void Simulation::Impl::forces() {
     }
     compute_forces<G>(lists(), plan(), scene.solver.weight, with_bond ? &bond : nullptr, f, nodes.size());
     if (ledger.hourglass()) {
-        apply_hourglass_control<G::dim>(lists(), plan(),
-                                        hourglass_control_fields<G>(ledger.hourglass_power(nodes.size()), ledger.stiffness_power(nodes.size())),
-                                        real, scene.solver.hourglass_coefficient);
+        auto control = hourglass_control_fields<G>(ledger.hourglass_power(nodes.size()), ledger.stiffness_power(nodes.size()));
+        ledger.keep_hourglass_fits<G::dim>(control, real);
+        apply_hourglass_control<G::dim>(lists(), plan(), control, real, scene.solver.hourglass_coefficient);
     }
     if (!ghosts.empty()) {
         const auto all = ghosts.normal_reactions(nodes, real);

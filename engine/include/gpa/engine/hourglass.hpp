@@ -47,6 +47,17 @@ struct HourglassFields {
     // sum_j F_j . (w_j - w_i); the compatible energy update books the heat at the mean velocities of
     // the velocity update (docs/energy.md).
     std::array<const double*, D> power_velocity{};
+    // The fits of the centres, kept from the force pass for the energy booking's pass, which then
+    // makes the same forces without fitting again (same positions and velocities, same fit, the same
+    // forces bit for bit): per centre, the force scale (kappa_i / sum_k w_k for the damping,
+    // k_i / sum_k w_k for the stiffness form; 0 where the centre has no control or no fit) and the
+    // fitted matrix (Lfit_i, Ffit_i; D * D entries, row-major).
+    struct KeptFit {
+        double* scale = nullptr;
+        std::array<double*, D * D> matrix{};
+    };
+    KeptFit damping_fit, stiffness_fit;  // written when set and use_kept_fits is false
+    bool use_kept_fits = false;          // read the kept fits instead of fitting (no forces are added then)
 };
 
 template <int D>
