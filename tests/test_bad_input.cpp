@@ -71,7 +71,18 @@ TEST(BadInput, InfluenceDistanceOutsideItsRange) {
         EXPECT_NE(m.find("influence distance"), std::string::npos) << m;
         EXPECT_NE(m.find("0.8-1.5"), std::string::npos) << m;
         EXPECT_THROW((void)gradient_fields<2>(n, a), InputError);
+        // The checked value a run makes once (weights.hpp) refuses it where it is made.
+        const auto typed = message_of<InputError>([&] { (void)InfluenceDistance(a); });
+        EXPECT_NE(typed.find("0.8-1.5"), std::string::npos) << typed;
     }
+    // In range: the typed and the plain overloads give the same views and the same lists.
+    const InfluenceDistance checked(1.3);
+    EXPECT_EQ(checked.value(), 1.3);
+    EXPECT_EQ(pair_fields<2>(n, checked).influence_distance, pair_fields<2>(n, 1.3).influence_distance);
+    CompressedRows typed_lists;
+    NeighbourScratch scratch;
+    find_neighbours(n, checked, n.size(), typed_lists, scratch);
+    EXPECT_EQ(typed_lists, find_neighbours(n, 1.3, n.size()));
 }
 
 TEST(BadInput, EmptyNeighbourhoodNamesTheNode) {

@@ -293,11 +293,17 @@ TEST_P(Hourglass, TheBookingPassMakesTheSameForcesFromTheKeptFits) {
                 << "centre " << i << ": " << a_fresh.damping << " fitted again, " << a_kept.damping << " from the kept fit";
             ASSERT_EQ(std::memcmp(&a_fresh.stiffness, &a_kept.stiffness, sizeof(double)), 0)
                 << "centre " << i << ": " << a_fresh.stiffness << " fitted again, " << a_kept.stiffness << " from the kept fit";
-            if (controlled) EXPECT_NE(a_kept.damping, 0.0) << "centre " << i;
-            if (controlled && nodes.connectivity[i] == Connectivity::Fixed) EXPECT_NE(a_kept.stiffness, 0.0) << "centre " << i;
+            if (controlled) {
+                EXPECT_NE(a_kept.damping, 0.0) << "centre " << i;
+            }
+            if (controlled && nodes.connectivity[i] == Connectivity::Fixed) {
+                EXPECT_NE(a_kept.stiffness, 0.0) << "centre " << i;
+            }
         }
         EXPECT_GT(kept, 0u);
-        if (c.connectivity == Connectivity::Variable) EXPECT_GT(without, 0u);
+        if (c.connectivity == Connectivity::Variable) {
+            EXPECT_GT(without, 0u);
+        }
     };
     if (dim == 2) {
         run.template operator()<2>();

@@ -24,20 +24,19 @@ void check_dim(const NodeStore& nodes, int d) {
 }  // namespace
 
 template <int D>
-PairFields<D> pair_fields(const NodeStore& nodes, double influence_distance) {
+PairFields<D> pair_fields(const NodeStore& nodes, InfluenceDistance influence_distance) {
     check_dim(nodes, D);
-    check_influence_distance(influence_distance);
     PairFields<D> p;
     for (int c = 0; c < D; ++c) p.position[c] = nodes.position[c].data();
     p.diameter = nodes.diameter.data();
     p.connectivity = nodes.connectivity.data();
     p.body = nodes.body.data();
-    p.influence_distance = influence_distance;
+    p.influence_distance = influence_distance.value();
     return p;
 }
 
 template <int D>
-GradientFields<D> gradient_fields(NodeStore& nodes, double influence_distance) {
+GradientFields<D> gradient_fields(NodeStore& nodes, InfluenceDistance influence_distance) {
     GradientFields<D> g;
     g.pairs = pair_fields<D>(nodes, influence_distance);
     for (int c = 0; c < D; ++c) {
@@ -54,7 +53,7 @@ GradientFields<D> gradient_fields(NodeStore& nodes, double influence_distance) {
 }
 
 template <int D>
-ForceFields<D> force_fields(NodeStore& nodes, double influence_distance) {
+ForceFields<D> force_fields(NodeStore& nodes, InfluenceDistance influence_distance) {
     ForceFields<D> f;
     f.pairs = pair_fields<D>(nodes, influence_distance);
     f.volume = nodes.volume.data();
@@ -74,11 +73,11 @@ ForceFields<D> force_fields(NodeStore& nodes, double influence_distance) {
     return f;
 }
 
-template PairFields<2> pair_fields<2>(const NodeStore&, double);
-template PairFields<3> pair_fields<3>(const NodeStore&, double);
-template GradientFields<2> gradient_fields<2>(NodeStore&, double);
-template GradientFields<3> gradient_fields<3>(NodeStore&, double);
-template ForceFields<2> force_fields<2>(NodeStore&, double);
-template ForceFields<3> force_fields<3>(NodeStore&, double);
+template PairFields<2> pair_fields<2>(const NodeStore&, InfluenceDistance);
+template PairFields<3> pair_fields<3>(const NodeStore&, InfluenceDistance);
+template GradientFields<2> gradient_fields<2>(NodeStore&, InfluenceDistance);
+template GradientFields<3> gradient_fields<3>(NodeStore&, InfluenceDistance);
+template ForceFields<2> force_fields<2>(NodeStore&, InfluenceDistance);
+template ForceFields<3> force_fields<3>(NodeStore&, InfluenceDistance);
 
 }  // namespace gpa

@@ -108,7 +108,12 @@ bool needs_search(const NodeStore& nodes, std::size_t centres) {
 
 void find_neighbours(const NodeStore& nodes, double a, std::size_t centres, CompressedRows& out,
                      NeighbourScratch& scratch, const CompressedRows* extra_fixed, double skin, bool fixed_may_switch) {
-    check_influence_distance(a);
+    find_neighbours(nodes, InfluenceDistance(a), centres, out, scratch, extra_fixed, skin, fixed_may_switch);
+}
+
+void find_neighbours(const NodeStore& nodes, InfluenceDistance influence, std::size_t centres, CompressedRows& out,
+                     NeighbourScratch& scratch, const CompressedRows* extra_fixed, double skin, bool fixed_may_switch) {
+    const double a = influence.value();
     if (!(skin >= 0.0) || !std::isfinite(skin)) throw InputError(fmt::format("find_neighbours: skin {} must be a finite length >= 0", skin));
     const std::size_t n = nodes.size();
     if (centres > n) throw InputError(fmt::format("find_neighbours: {} centres of {} nodes", centres, n));

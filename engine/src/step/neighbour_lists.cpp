@@ -57,8 +57,8 @@ void NeighbourLists::invalidate() {
     search_due_ = true;
 }
 
-void NeighbourLists::place_ghosts(NodeStore& nodes, std::size_t real, GhostSet& ghosts, double influence_distance, bool first) {
-    const double range = largest_interaction_radius(nodes, influence_distance, real);
+void NeighbourLists::place_ghosts(NodeStore& nodes, std::size_t real, GhostSet& ghosts, InfluenceDistance influence_distance, bool first) {
+    const double range = largest_interaction_radius(nodes, influence_distance.value(), real);
     if (with_skin_ && !search_due_) search_due_ = candidates_stale(nodes, real, ghosts, influence_distance, range);
     if (ghosts.empty()) return;
     ghosts.update_contacts(nodes, real, first);
@@ -74,7 +74,7 @@ void NeighbourLists::place_ghosts(NodeStore& nodes, std::size_t real, GhostSet& 
 }
 
 bool NeighbourLists::candidates_stale(const NodeStore& nodes, std::size_t real, const GhostSet& ghosts,
-                                      double influence_distance, double range) const {
+                                      InfluenceDistance influence_distance, double range) const {
     // A pair (i, j) left out by the last search had r >= 2 h_ij + skin then. Now r has shrunk by
     // at most |u_i - u_j| <= 2 max |u - U| (u the displacements since the search, U any common
     // translation: the middle of the u), and 2 h_ij has grown by at most 2 a max (d - d_then).
@@ -128,11 +128,11 @@ bool NeighbourLists::candidates_stale(const NodeStore& nodes, std::size_t real, 
         closing = std::max(closing, ghosts.mirrored_displacement_bound(nodes, real, searched_position_));
     }
     // NaN positions make the bound NaN: search, and let the phases report them.
-    return !(closing + 2.0 * influence_distance * e.growth < skin_);
+    return !(closing + 2.0 * influence_distance.value() * e.growth < skin_);
 }
 
 void NeighbourLists::check_against_search(const NodeStore& nodes, std::size_t real, const GhostSet& ghosts,
-                                          double influence_distance, std::size_t step) const {
+                                          InfluenceDistance influence_distance, std::size_t step) const {
     // The pairs a step without a skin would have: fresh ghosts (only the nodes in contact across
     // lift-off planes) in a copy of the nodes, a full search, the contact rule. A ghost entry is
     // compared as (source node, planes), since the two ghost sets number their ghosts differently.
@@ -142,7 +142,7 @@ void NeighbourLists::check_against_search(const NodeStore& nodes, std::size_t re
     NeighbourScratch scratch;
     const CompressedRows* mirrored = nullptr;
     if (!ghosts.empty()) {
-        fresh_ghosts.build(copy, real, largest_interaction_radius(nodes, influence_distance, real));
+        fresh_ghosts.build(copy, real, largest_interaction_radius(nodes, influence_distance.value(), real));
         mirrored = &fresh_ghosts.resolved_fixed_mirrors(copy, real);
     }
     find_neighbours(copy, influence_distance, real, fresh, scratch, mirrored);
@@ -166,10 +166,10 @@ void NeighbourLists::check_against_search(const NodeStore& nodes, std::size_t re
     }
 }
 
-void NeighbourLists::search_candidates(NodeStore& nodes, std::size_t real, GhostSet& ghosts, double influence_distance,
+void NeighbourLists::search_candidates(NodeStore& nodes, std::size_t real, GhostSet& ghosts, InfluenceDistance influence_distance,
                                        bool any_automatic) {
     const CompressedRows* mirrored = ghosts.empty() ? nullptr : &ghosts.resolved_fixed_mirrors(nodes, real);
-    if (ghosts.empty()) skin_ = solver_->neighbour_skin * largest_interaction_radius(nodes, influence_distance, real);
+    if (ghosts.empty()) skin_ = solver_->neighbour_skin * largest_interaction_radius(nodes, influence_distance.value(), real);
     find_neighbours(nodes, influence_distance, real, candidates_, scratch_, mirrored, skin_, any_automatic);
     lattice_entries_.assign(real, 0);
     for (std::size_t i = 0; i < real; ++i) {
@@ -195,16 +195,16 @@ void NeighbourLists::search_candidates(NodeStore& nodes, std::size_t real, Ghost
     ++searches_;
 }
 
-void NeighbourLists::update(NodeStore& nodes, std::size_t real, GhostSet& ghosts, double influence_distance, bool any_automatic,
+void NeighbourLists::update(NodeStore& nodes, std::size_t real, GhostSet& ghosts, InfluenceDistance influence_distance, bool any_automatic,
                             Contact& contact, std::size_t step) {
     if (constant_ && lists_.rows() == real) return;
     const int d = nodes.dim();
     if (with_skin_) {
         if (search_due_) search_candidates(nodes, real, ghosts, influence_distance, any_automatic);
-        filter_candidates(nodes, influence_distance, candidates_, lattice_entries_, lists_, keep_scratch_);
+        filter_candidates(nodes, influence_distance.value(), candidates_, lattice_entries_, lists_, keep_scratch_);
         if (!ghosts.empty()) ghosts.remove_pairs_without_contact(lists_, nodes, real);
         if (solver_->check_neighbour_lists) check_against_search(nodes, real, ghosts, influence_distance, step);
-        contact.separate(lists_, nodes, real, influence_distance);
+        contact.separate(lists_, nodes, real, influence_distance.value());
         if (!ghosts.empty()) ghosts.append_ghost_rows(lists_, real);
         contact.mirror_directions(ghosts, d, real);
         return;
@@ -213,13 +213,13 @@ void NeighbourLists::update(NodeStore& nodes, std::size_t real, GhostSet& ghosts
     plan_due_ = true;
     if (ghosts.empty()) {
         find_neighbours(nodes, influence_distance, real, lists_, scratch_);
-        contact.separate(lists_, nodes, real, influence_distance);
+        contact.separate(lists_, nodes, real, influence_distance.value());
         return;
     }
     const CompressedRows& mirrored = ghosts.resolved_fixed_mirrors(nodes, real);
     find_neighbours(nodes, influence_distance, real, lists_, scratch_, &mirrored);
     ghosts.remove_pairs_without_contact(lists_, nodes, real);
-    contact.separate(lists_, nodes, real, influence_distance);
+    contact.separate(lists_, nodes, real, influence_distance.value());
     ghosts.append_ghost_rows(lists_, real);
     contact.mirror_directions(ghosts, d, real);
 }

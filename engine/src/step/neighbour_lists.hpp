@@ -48,13 +48,13 @@ public:
     // Geometry phase, after the diameters: decides whether the candidates are stale, then places
     // the ghosts of `ghosts` (all within reach of a plane, with the skin when a search is due;
     // `first` on the set-up's call, when contacts start from the initial state).
-    void place_ghosts(NodeStore& nodes, std::size_t real, GhostSet& ghosts, double influence_distance, bool first);
+    void place_ghosts(NodeStore& nodes, std::size_t real, GhostSet& ghosts, InfluenceDistance influence_distance, bool first);
 
     // Neighbours phase: the lists of this step, from the candidates (searched again when due) or
     // from a full search; pairs across planes without contact out, open separable pairs out
     // (contact), ghost rows appended. `any_automatic`: the search keeps fixed centres' candidates
     // too. `step` names the step in the error of check_neighbour_lists.
-    void update(NodeStore& nodes, std::size_t real, GhostSet& ghosts, double influence_distance, bool any_automatic,
+    void update(NodeStore& nodes, std::size_t real, GhostSet& ghosts, InfluenceDistance influence_distance, bool any_automatic,
                 Contact& contact, std::size_t step);
 
     // Plan phase: a plan for lists searched without a skin (with a skin the search made one that
@@ -67,11 +67,11 @@ public:
     void read_state(StateReader& in, int dim, std::size_t node_count);
 
 private:
-    bool candidates_stale(const NodeStore& nodes, std::size_t real, const GhostSet& ghosts, double influence_distance,
+    bool candidates_stale(const NodeStore& nodes, std::size_t real, const GhostSet& ghosts, InfluenceDistance influence_distance,
                           double range) const;
-    void search_candidates(NodeStore& nodes, std::size_t real, GhostSet& ghosts, double influence_distance,
+    void search_candidates(NodeStore& nodes, std::size_t real, GhostSet& ghosts, InfluenceDistance influence_distance,
                            bool any_automatic);
-    void check_against_search(const NodeStore& nodes, std::size_t real, const GhostSet& ghosts, double influence_distance,
+    void check_against_search(const NodeStore& nodes, std::size_t real, const GhostSet& ghosts, InfluenceDistance influence_distance,
                               std::size_t step) const;
 
     const SolverOptions* solver_;

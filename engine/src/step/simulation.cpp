@@ -96,7 +96,9 @@ struct Simulation::Impl {
           run_control(scene, std::move(memory)) {}
 
     int dim() const { return nodes.dim(); }
-    double a() const { return scene.solver.influence_distance; }
+    // a, checked once in setup (after validate_scene, whose message names the scene's key).
+    std::optional<InfluenceDistance> influence;
+    InfluenceDistance a() const { return *influence; }
 
     template <class G>
     void setup();
@@ -135,7 +137,7 @@ struct Simulation::Impl {
 template <class G>
 void Simulation::Impl::setup() {
     validate_scene(scene);
-    check_influence_distance(a());
+    influence.emplace(scene.solver.influence_distance);
     // Planes with ghosts: the axis of an axisymmetric scene first, then the scene's planes.
     std::vector<GhostPlane> planes;
     if (G::axisymmetric) planes.push_back({"axis", 0, 0.0, +1, false, false});
@@ -206,7 +208,7 @@ void Simulation::Impl::regroup_materials() {
 
 void Simulation::Impl::reorder() {
     nodes.resize(real);  // ghosts are rebuilt after every move
-    const double cell = largest_interaction_radius(nodes, a(), real);
+    const double cell = largest_interaction_radius(nodes, a().value(), real);
     nodes.permute(locality_order(nodes, cell, 0, real));
     neighbour_lists.invalidate();  // rebuilt in the new numbering by the neighbours phase
     regroup_materials();

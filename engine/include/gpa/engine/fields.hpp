@@ -174,11 +174,25 @@ inline double out_of_plane_stress(const std::array<const double*, 6>& s, const d
     return s[3][i] - pressure[i] - (viscous_pressure ? viscous_pressure[i] : 0.0);
 }
 
+// The views of a NodeStore's arrays (valid until the store is resized). The double overloads
+// check a's range on every call (weights.hpp, InfluenceDistance).
 template <int D>
-PairFields<D> pair_fields(const NodeStore& nodes, double influence_distance);
+PairFields<D> pair_fields(const NodeStore& nodes, InfluenceDistance influence_distance);
 template <int D>
-GradientFields<D> gradient_fields(NodeStore& nodes, double influence_distance);
+GradientFields<D> gradient_fields(NodeStore& nodes, InfluenceDistance influence_distance);
 template <int D>
-ForceFields<D> force_fields(NodeStore& nodes, double influence_distance);
+ForceFields<D> force_fields(NodeStore& nodes, InfluenceDistance influence_distance);
+template <int D>
+PairFields<D> pair_fields(const NodeStore& nodes, double influence_distance) {
+    return pair_fields<D>(nodes, InfluenceDistance(influence_distance));
+}
+template <int D>
+GradientFields<D> gradient_fields(NodeStore& nodes, double influence_distance) {
+    return gradient_fields<D>(nodes, InfluenceDistance(influence_distance));
+}
+template <int D>
+ForceFields<D> force_fields(NodeStore& nodes, double influence_distance) {
+    return force_fields<D>(nodes, InfluenceDistance(influence_distance));
+}
 
 }  // namespace gpa

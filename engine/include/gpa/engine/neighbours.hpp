@@ -12,6 +12,7 @@
 
 #include "gpa/engine/compressed_rows.hpp"
 #include "gpa/engine/node_store.hpp"
+#include "gpa/engine/weights.hpp"
 
 namespace gpa {
 
@@ -60,6 +61,10 @@ struct NeighbourScratch {
 // outlive switching: a fixed centre's row holds all its lattice neighbours and mirrors, of either
 // mode, then every other node within reach, fixed nodes of its body included.
 void find_neighbours(const NodeStore& nodes, double influence_distance, std::size_t centres,
+                     CompressedRows& out, NeighbourScratch& scratch,
+                     const CompressedRows* extra_fixed = nullptr, double skin = 0.0, bool fixed_may_switch = false);
+// The same with a checked once (weights.hpp, InfluenceDistance): what a run calls.
+void find_neighbours(const NodeStore& nodes, InfluenceDistance influence_distance, std::size_t centres,
                      CompressedRows& out, NeighbourScratch& scratch,
                      const CompressedRows* extra_fixed = nullptr, double skin = 0.0, bool fixed_may_switch = false);
 CompressedRows find_neighbours(const NodeStore& nodes, double influence_distance, std::size_t centres);

@@ -60,4 +60,17 @@ inline constexpr double max_influence_distance = 1.5;
 // Throws InputError when a is outside [0.8, 1.5] or not finite.
 void check_influence_distance(double influence_distance);
 
+// The influence distance a, checked once: a value of this type is within the method's range, so
+// the code that is handed one every step (the field views, the neighbour search) checks nothing.
+// A run makes it once from its validated scene; the overloads that take a plain double (for
+// programs that call the kernels directly) make one, and so check, on every call.
+class InfluenceDistance {
+public:
+    explicit InfluenceDistance(double a) : a_(a) { check_influence_distance(a); }
+    double value() const { return a_; }
+
+private:
+    double a_;
+};
+
 }  // namespace gpa
