@@ -32,8 +32,9 @@ double* EnergyLedger::stiffness_power(std::size_t count) { return stiffness_ ? z
 template <int D>
 void EnergyLedger::keep_hourglass_fits(HourglassFields<D>& control, std::size_t count) {
     if (!compatible_) return;
+    // Sized to the real nodes exactly (no slack: their number does not change during a run).
     const auto point = [count](std::array<std::vector<double>, 10>& store, typename HourglassFields<D>::KeptFit& kept) {
-        for (int k = 0; k <= D * D; ++k) resize_with_slack(store[k], count);
+        for (int k = 0; k <= D * D; ++k) store[k].resize(count);
         kept.scale = store[0].data();
         for (int k = 0; k < D * D; ++k) kept.matrix[k] = store[k + 1].data();
     };
