@@ -17,6 +17,9 @@ namespace gpa {
 namespace {
 
 constexpr std::size_t search_block = 1024;  // centres per task; fixed so lists never depend on threads
+// Rows per task of the cut of candidates to pairs (filter_rows): each row is cut on its own, so the
+// split never changes the lists; small enough that 10^3 nodes still give every thread work.
+constexpr std::size_t filter_block = 128;
 
 double squared_distance(const NodeStore& s, std::size_t i, std::size_t j) {
     double r2 = 0.0;
@@ -236,7 +239,7 @@ void filter_rows(const NodeStore& nodes, double a, const CompressedRows& candida
     // when r_ij < 2 h_ij and it is not a pair of two fixed nodes of one body.
     const Connectivity* mode = nodes.connectivity.data();
     const std::int32_t* body = nodes.body.data();
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rows, search_block), [&](const tbb::blocked_range<std::size_t>& r) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rows, filter_block), [&](const tbb::blocked_range<std::size_t>& r) {
         for (std::size_t i = r.begin(); i != r.end(); ++i) {
             const std::size_t first = candidates.offsets[i], last = candidates.offsets[i + 1];
             const std::size_t lattice_end = std::min(last, first + lattice_entries[i]);
@@ -271,7 +274,7 @@ void filter_rows(const NodeStore& nodes, double a, const CompressedRows& candida
     for (std::size_t i = 0; i < rows; ++i) out.offsets[i + 1] += out.offsets[i];
     resize_with_slack(out.indices, out.offsets[rows]);
     // Pass 2: copy the kept entries in order.
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rows, search_block), [&](const tbb::blocked_range<std::size_t>& r) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rows, filter_block), [&](const tbb::blocked_range<std::size_t>& r) {
         for (std::size_t i = r.begin(); i != r.end(); ++i) {
             std::size_t o = out.offsets[i];
             for (std::size_t e = candidates.offsets[i]; e < candidates.offsets[i + 1]; ++e) {
