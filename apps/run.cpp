@@ -48,10 +48,20 @@ struct SceneSource {
     std::string label;  // for the summary's scene_file
 };
 
+// The file the built-in default scene was embedded from: the files it names (its element
+// reference) are found beside it, in the source tree the program was built from.
+const fs::path default_scene_file{GPA_DEFAULT_SCENE_FILE};
+constexpr const char* builtin_label = "(built-in default)";  // the summary's scene_file of the built-in scene
+
+// Resolves the files a scene names relative to the file its text came from (the built-in scene's:
+// default_scene_file) and says, whatever --quiet, when one is not there (io::resolve_scene_files).
+void resolve_files(Scene& scene, const fs::path& scene_file) {
+    if (const std::string warning = io::resolve_scene_files(scene, scene_file); !warning.empty()) spdlog::warn("{}", warning);
+}
+
 SceneSource read_source(const std::optional<fs::path>& file) {
     if (file) return {io::read_scene_text(*file), file->string(), file->string()};
-    return {std::string(default_scene_text()), "built-in default scene (scenes/armco-cylinder-nodal.toml)",
-            "(built-in default)"};
+    return {std::string(default_scene_text()), "built-in default scene (scenes/armco-cylinder-nodal.toml)", builtin_label};
 }
 
 // Scheduled snapshot times: t_k = k * interval for whole k, from `snapshot_interval`, or from
@@ -564,7 +574,7 @@ private:
 int fresh_run(const RunOptions& options) {
     SceneSource source = read_source(options.scene);
     Scene scene = io::parse_scene(source.text, source.name);
-    if (options.scene) io::resolve_scene_files(scene, *options.scene);
+    resolve_files(scene, options.scene ? *options.scene : default_scene_file);
     const fs::path output = options.output.value_or(default_output_folder("runs", scene.name));
     Simulation sim(scene, options.threads, options.memory);  // before the folder: an impossible scene leaves nothing behind
     io::RunFolder folder(output, options.overwrite);
@@ -618,10 +628,11 @@ int resumed_run(const RunOptions& options) {
     Scene scene = io::parse_scene(source.text, source.name);
     // The files the scene names are relative to the scene file the run started from (the copy in
     // the folder has no such neighbours); one that is no longer there is reported at the end.
-    const fs::path original = options.scene ? *options.scene : fs::path(decode(info.user_data, checkpoint.string()).scene_file);
+    const std::string started_from = decode(info.user_data, checkpoint.string()).scene_file;
+    const fs::path original = options.scene ? *options.scene : started_from == builtin_label ? default_scene_file : fs::path(started_from);
     if (!scene.element_reference.empty() && fs::exists(original)) {
         try {
-            io::resolve_scene_files(scene, original);
+            resolve_files(scene, original);
         } catch (const InputError& e) {
             spdlog::warn("{}", e.what());
         }
@@ -655,7 +666,8 @@ fs::path default_output_folder(const std::string& root, const std::string& scene
 }
 
 int check_scene(const fs::path& file, const MemoryLimit& memory) {
-    const Scene scene = io::load_scene(file);
+    std::string warning;
+    const Scene scene = io::load_scene(file, &warning);
     Simulation sim(scene, 1, memory);  // builds the nodes: every check of set-up runs
     fmt::print("{}: OK\n", file.string());
     fmt::print("  {} ({}), {} bod{}, {} real nodes, {} ghost nodes at the start\n", scene.name, name_of(scene.geometry),
@@ -669,8 +681,11 @@ int check_scene(const fs::path& file, const MemoryLimit& memory) {
             count = static_cast<std::size_t>(std::count(e->mesh().nodes.body.begin(), e->mesh().nodes.body.end(), static_cast<int>(b)));
             elements = fmt::format(" ({} elements)", std::count(e->mesh().quads.body.begin(), e->mesh().quads.body.end(), static_cast<int>(b)));
         }
-        fmt::print("  body \"{}\": {}, {} nodes{}, lattice spacing {:.4g} x {:.4g} mm\n", scene.bodies[b].name,
-                   scene.bodies[b].material, count, elements, block.spacing[0] * 1e3, block.spacing[1] * 1e3);
+        // Every axis's spacing: x, z in 2D; x, y, z in 3D.
+        std::vector<std::string> spacing;
+        for (int c = 0; c < dimension_of(scene.geometry); ++c) spacing.push_back(fmt::format("{:.4g}", block.spacing[c] * 1e3));
+        fmt::print("  body \"{}\": {}, {} nodes{}, lattice spacing {} mm\n", scene.bodies[b].name, scene.bodies[b].material, count,
+                   elements, fmt::join(spacing, " x "));
     }
     for (std::size_t k = 0; k < scene.prescribed_velocities.size(); ++k) {
         const auto& r = scene.prescribed_velocities[k];
@@ -683,6 +698,7 @@ int check_scene(const fs::path& file, const MemoryLimit& memory) {
                    r.ramp > 0.0 ? fmt::format(" after a {:.4g} us ramp", r.ramp * 1e6) : std::string());
     }
     fmt::print("  first time step {:.3g} ns; phases: {}\n", sim.next_time_step() * 1e9, fmt::join(sim.phases(), ", "));
+    if (!warning.empty()) fmt::print("  warning: {}\n", warning);
     return 0;
 }
 

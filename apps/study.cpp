@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include <fmt/format.h>
+#include <spdlog/spdlog.h>
 #include <sys/resource.h>
 #include <unistd.h>
 #if defined(__GLIBC__)
@@ -154,7 +155,9 @@ void print_summary(const io::StudyReport& report, const io::StudyAnalysis& analy
 
 int run_study(const StudyOptions& options) {
     // Everything that can be refused is checked before the output folder exists.
-    const Scene scene = io::load_scene(options.scene);
+    std::string reference_warning;
+    const Scene scene = io::load_scene(options.scene, &reference_warning);
+    if (!reference_warning.empty()) spdlog::warn("{}", reference_warning);
     const std::vector<double> factors = io::parse_refinements(options.refine);
     const std::vector<int> thread_counts = io::parse_thread_counts(options.threads);
     std::vector<io::Variant> variants;
@@ -248,7 +251,10 @@ int run_study(const StudyOptions& options) {
     report.variants = variants;
     report.reference = scene.reference;
     report.reference_source = scene.reference_source;
-    if (!scene.element_reference.empty()) report.element_reference = io::read_element_reference(scene.element_reference);
+    // A reference that is not there was a warning above: the study is not compared with it.
+    if (!scene.element_reference.empty() && reference_warning.empty()) {
+        report.element_reference = io::read_element_reference(scene.element_reference);
+    }
     MemoryGauge memory;
     report.memory_note = memory.note();
     if (!options.quiet) {

@@ -617,21 +617,29 @@ std::string read_scene_text(const std::filesystem::path& file) {
     return text;
 }
 
-void resolve_scene_files(Scene& scene, const std::filesystem::path& scene_file) {
-    if (scene.element_reference.empty()) return;
+std::string resolve_scene_files(Scene& scene, const std::filesystem::path& scene_file) {
+    if (scene.element_reference.empty()) return {};
     if (std::filesystem::path(scene.element_reference).is_relative()) {
         scene.element_reference = (scene_file.parent_path() / scene.element_reference).lexically_normal().string();
+    }
+    std::error_code ec;
+    if (!std::filesystem::exists(scene.element_reference, ec)) {
+        return fmt::format("{}: reference.elements: {} is not there: the run will not be compared with element results "
+                           "(copy the reference beside the scene, or write one with gpa study --reference)",
+                           scene_file.string(), scene.element_reference);
     }
     try {
         read_element_reference(scene.element_reference);
     } catch (const InputError& e) {
         throw InputError(fmt::format("{}: reference.elements: {}", scene_file.string(), e.what()));
     }
+    return {};
 }
 
-Scene load_scene(const std::filesystem::path& file) {
+Scene load_scene(const std::filesystem::path& file, std::string* warning) {
     Scene scene = parse_scene(read_scene_text(file), file.string());
-    resolve_scene_files(scene, file);
+    std::string w = resolve_scene_files(scene, file);
+    if (warning) *warning = std::move(w);
     return scene;
 }
 

@@ -22,13 +22,17 @@ public:
 };
 
 // Reads and parses a scene file, then resolves the files it names (resolve_scene_files). Messages
-// name the file as given. Throws SceneError (also when the file cannot be read).
-Scene load_scene(const std::filesystem::path& file);
+// name the file as given. Throws SceneError (also when the file cannot be read); the warning of
+// resolve_scene_files goes to *warning when given.
+Scene load_scene(const std::filesystem::path& file, std::string* warning = nullptr);
 
 // Makes the relative file names of a parsed scene (`[reference] elements`) relative to the folder
-// of `scene_file`, the file the text came from, and checks that they can be read: a scene is
-// refused at once, naming the key, rather than at the end of its run. Throws InputError.
-void resolve_scene_files(Scene& scene, const std::filesystem::path& scene_file);
+// of `scene_file`, the file the text came from, and checks them. A reference that is not there is
+// no reason to refuse the scene (a shipped scene copied to another folder has none beside it): the
+// returned warning names it and says that the run will not be compared with it (empty when all is
+// there). A reference that is there but cannot be read (a folder, an empty or malformed file) is
+// refused at once, naming the key, rather than at the end of the run: InputError.
+std::string resolve_scene_files(Scene& scene, const std::filesystem::path& scene_file);
 
 // The bytes of a scene file, read with the scene-size limit (16 MiB) whatever the file is: a
 // device or a pipe that never ends is refused once it passes the limit. Throws SceneError.
