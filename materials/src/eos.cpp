@@ -28,8 +28,10 @@ HugoniotFactor hugoniot_factor(double gruneisen, double mu) {
     return {1.0 - gruneisen * mu / (2.0 * one_plus_mu), -gruneisen / (2.0 * one_plus_mu * one_plus_mu)};
 }
 
+}  // namespace
+
 // P = K mu (or K ln(rho / rho0)); no energy dependence (materials.md, "linear").
-EosTerms linear_terms(const LinearEos& eos, double rho0, double rho) {
+EosTerms model_terms(const LinearEos& eos, double rho0, double rho) {
     EosTerms t;
     if (eos.logarithmic) {
         t.a = eos.bulk_modulus * std::log(rho / rho0);
@@ -43,7 +45,7 @@ EosTerms linear_terms(const LinearEos& eos, double rho0, double rho) {
 
 // EPIC polynomial: compression P = (K1 mu + K2 mu^2 + K3 mu^3) g(mu) + Gamma0 rho0 e;
 // tension P = K1 mu + Gamma0 rho0 e (materials.md, "polynomial"; header PolynomialEos).
-EosTerms polynomial_terms(const PolynomialEos& eos, double rho0, double rho) {
+EosTerms model_terms(const PolynomialEos& eos, double rho0, double rho) {
     const double mu = rho / rho0 - 1.0;
     EosTerms t;
     t.b = eos.gruneisen * rho0;
@@ -67,8 +69,8 @@ EosTerms polynomial_terms(const PolynomialEos& eos, double rho0, double rho) {
 // is mu >= 0.9 / (s - 1) (kPoleMargin = 0.1). There P_H is already 100 mu (1 + mu) rho0 c0^2
 // (for copper, s = 1.489: mu = 1.84, P_H ~ 520 rho0 c0^2 ~ 70 TPa), two orders of magnitude beyond
 // the shock data any linear Us-up fit comes from; a node that gets there has tangled, and a loud
-// error beats an overflowing pressure.
-EosTerms mie_gruneisen_terms(const MieGruneisenEos& eos, double rho0, double rho) {
+// error beats an overflowing pressure (EosTerms::beyond_limit, eos_limit_message).
+EosTerms model_terms(const MieGruneisenEos& eos, double rho0, double rho) {
     const double mu = rho / rho0 - 1.0;
     const double k0 = rho0 * eos.sound_speed * eos.sound_speed;
     EosTerms t;
@@ -76,10 +78,8 @@ EosTerms mie_gruneisen_terms(const MieGruneisenEos& eos, double rho0, double rho
     if (mu > 0.0) {
         const double sm1 = eos.slope - 1.0;
         if (sm1 > 0.0 && !(sm1 * mu < 1.0 - kPoleMargin)) {
-            throw std::domain_error(fmt::format(
-                "Mie-Gruneisen EOS: compression mu = {:.6g} (rho = {:.6g} kg/m^3) is at or beyond the limit "
-                "mu = {:.6g}, {:g} % short of the Hugoniot pole mu = 1/(s - 1) = {:.6g} (s = {:g})",
-                mu, rho, (1.0 - kPoleMargin) / sm1, 100.0 * kPoleMargin, 1.0 / sm1, eos.slope));
+            t.beyond_limit = true;
+            return t;
         }
         const double eta = 1.0 - sm1 * mu;  // > 0.1 when s > 1; >= 1 when s <= 1
         const double p_h = k0 * mu * (1.0 + mu) / (eta * eta);
@@ -94,7 +94,14 @@ EosTerms mie_gruneisen_terms(const MieGruneisenEos& eos, double rho0, double rho
     return t;
 }
 
-}  // namespace
+std::string eos_limit_message(const MieGruneisenEos& eos, double rho0, double rho) {
+    const double mu = rho / rho0 - 1.0;
+    const double sm1 = eos.slope - 1.0;
+    return fmt::format(
+        "Mie-Gruneisen EOS: compression mu = {:.6g} (rho = {:.6g} kg/m^3) is at or beyond the limit "
+        "mu = {:.6g}, {:g} % short of the Hugoniot pole mu = 1/(s - 1) = {:.6g} (s = {:g})",
+        mu, rho, (1.0 - kPoleMargin) / sm1, 100.0 * kPoleMargin, 1.0 / sm1, eos.slope);
+}
 
 // P = a(rho) + b(rho) e for the model held by `eos` (materials.md, "Equation of state").
 EosTerms eos_terms(const EquationOfState& eos, double reference_density, double density) {
@@ -104,14 +111,11 @@ EosTerms eos_terms(const EquationOfState& eos, double reference_density, double 
     }
     return std::visit(
         [&](const auto& model) -> EosTerms {
-            using T = std::decay_t<decltype(model)>;
-            if constexpr (std::is_same_v<T, LinearEos>) {
-                return linear_terms(model, reference_density, density);
-            } else if constexpr (std::is_same_v<T, PolynomialEos>) {
-                return polynomial_terms(model, reference_density, density);
-            } else {
-                return mie_gruneisen_terms(model, reference_density, density);
+            const EosTerms t = model_terms(model, reference_density, density);
+            if constexpr (std::is_same_v<std::decay_t<decltype(model)>, MieGruneisenEos>) {
+                if (t.beyond_limit) throw std::domain_error(eos_limit_message(model, reference_density, density));
             }
+            return t;
         },
         eos);
 }

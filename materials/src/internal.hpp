@@ -1,6 +1,8 @@
 #pragma once
 // Helpers shared by the material model sources; not part of the public API.
 
+#include <string>
+
 #include <Eigen/Core>
 
 #include "gpa/materials/material.hpp"
@@ -15,8 +17,22 @@ struct EosTerms {
     double b = 0.0;        // dP/de at fixed rho, kg/m^3
     double da_drho = 0.0;  // m^2/s^2
     double db_drho = 0.0;  // 1 (zero for every model here: Gamma rho = Gamma0 rho0)
+    // Mie-Grueneisen only: the density is at or beyond the compression guard short of the Hugoniot
+    // pole (eos.cpp); the other terms are then not evaluated.
+    bool beyond_limit = false;
 };
 
+// The terms of one model, chosen by overload (a PointModel picks them once per material). The
+// density must be positive and finite (the point update checks it first).
+EosTerms model_terms(const LinearEos& eos, double reference_density, double density);
+EosTerms model_terms(const PolynomialEos& eos, double reference_density, double density);
+EosTerms model_terms(const MieGruneisenEos& eos, double reference_density, double density);
+
+// The words for a density beyond the Mie-Grueneisen guard (EosTerms::beyond_limit).
+std::string eos_limit_message(const MieGruneisenEos& eos, double reference_density, double density);
+
+// The terms of the model held by `eos`; throws std::domain_error for a density that is not
+// positive and finite, or beyond the Mie-Grueneisen guard (eos_limit_message).
 EosTerms eos_terms(const EquationOfState& eos, double reference_density, double density);
 
 // The bulk modulus of the unstressed material: K (linear), K1 (polynomial), rho0 c0^2 (Mie-Grueneisen).
@@ -64,5 +80,13 @@ struct ReturnResult {
 // d eps_p / dt of the return itself (Johnson and Cook 1983 define epsdot* so).
 ReturnResult radial_return(const Strength& strength, const Eigen::Matrix3d& trial, double shear_modulus,
                            double plastic_strain, double dt, double homologous_temperature);
+
+// The same return for one strength model, chosen by overload (a PointModel picks it once per material).
+ReturnResult model_return(const ElasticStrength& strength, const Eigen::Matrix3d& trial, double shear_modulus,
+                          double plastic_strain, double dt, double homologous_temperature);
+ReturnResult model_return(const VonMisesStrength& strength, const Eigen::Matrix3d& trial, double shear_modulus,
+                          double plastic_strain, double dt, double homologous_temperature);
+ReturnResult model_return(const JohnsonCookStrength& strength, const Eigen::Matrix3d& trial, double shear_modulus,
+                          double plastic_strain, double dt, double homologous_temperature);
 
 }  // namespace gpa::materials::detail

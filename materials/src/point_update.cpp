@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <string>
+#include <type_traits>
 #include <variant>
 
 #include <fmt/format.h>
@@ -23,18 +25,30 @@ double triaxiality(double pressure, double von_mises_stress, double reference_bu
     return -pressure / von_mises_stress;
 }
 
-void check_increment(const PointIncrement& inc) {
-    if (!(inc.density_old > 0.0) || !(inc.density_new > 0.0) || !std::isfinite(inc.density_old) ||
-        !std::isfinite(inc.density_new)) {
-        throw std::domain_error(fmt::format("point update: densities {} -> {} kg/m^3 must be positive and finite",
-                                            inc.density_old, inc.density_new));
-    }
-    if (!(inc.dt >= 0.0) || !std::isfinite(inc.dt)) {
-        throw std::domain_error(fmt::format("point update: time step {} s must be non-negative and finite", inc.dt));
-    }
+bool valid_increment(const PointIncrement& inc) {
+    return inc.density_old > 0.0 && inc.density_new > 0.0 && std::isfinite(inc.density_old) &&
+           std::isfinite(inc.density_new) && inc.dt >= 0.0 && std::isfinite(inc.dt);
 }
 
-}  // namespace
+std::string increment_message(const PointIncrement& inc) {
+    if (!(inc.density_old > 0.0) || !(inc.density_new > 0.0) || !std::isfinite(inc.density_old) ||
+        !std::isfinite(inc.density_new)) {
+        return fmt::format("point update: densities {} -> {} kg/m^3 must be positive and finite", inc.density_old,
+                           inc.density_new);
+    }
+    return fmt::format("point update: time step {} s must be non-negative and finite", inc.dt);
+}
+
+// 1 + b dv / 2 of the energy solve in step 4 below.
+double energy_solve_denominator(double b, const PointIncrement& inc) {
+    return 1.0 + 0.5 * b * (1.0 / inc.density_new - 1.0 / inc.density_old);
+}
+
+PointResult fault(PointFault what) {
+    PointResult r;
+    r.fault = what;
+    return r;
+}
 
 // Spec section 4 (hypoelastic-plastic update "in the standard manner") with the models of
 // materials.md. Steps, in order:
@@ -69,8 +83,14 @@ void check_increment(const PointIncrement& inc) {
 //  8. Sound speed sqrt((K_s + 4 G / 3) / rho_new), K_s from the EOS at (rho_new, e_new) floored as
 //     in eos.cpp; G = 0 when failed or molten (a plastic model whose strength saw T >= T_melt this
 //     step, so its deviator is zero). An elastic material has no melting: it keeps G.
-PointResult update_point(const Material& m, PointState& state, const PointIncrement& inc) {
-    check_increment(inc);
+// A fault (PointFault) returns before the state is touched. The models are template arguments:
+// PointModel picks the instantiation once per material.
+template <class Eos, class StrengthModel>
+PointResult update_with(const PointModel& model, PointState& state, const PointIncrement& inc) noexcept {
+    const Material& m = model.material();
+    const Eos& eos_model = *std::get_if<Eos>(&m.eos);
+    const StrengthModel& strength = *std::get_if<StrengthModel>(&m.strength);
+    if (!valid_increment(inc)) return fault(PointFault::bad_increment);
     const Eigen::Matrix3d identity = Eigen::Matrix3d::Identity();
 
     // 1. Rates.
@@ -80,7 +100,7 @@ PointResult update_point(const Material& m, PointState& state, const PointIncrem
     const Eigen::Matrix3d d_dev = d - (d.trace() / 3.0) * identity;
 
     const double t_star = homologous_temperature(m, state.temperature);
-    const bool plastic_model = !std::holds_alternative<ElasticStrength>(m.strength);
+    constexpr bool plastic_model = !std::is_same_v<StrengthModel, ElasticStrength>;
     const bool molten = plastic_model && t_star >= 1.0;
 
     // 2-3. Deviator: Jaumann trial and radial return.
@@ -95,7 +115,12 @@ PointResult update_point(const Material& m, PointState& state, const PointIncrem
         trial = (0.5 * (trial + trial.transpose())).eval();  // eval: no aliasing with transpose
         trial -= (trial.trace() / 3.0) * identity;
         const detail::ReturnResult r =
-            detail::radial_return(m.strength, trial, m.shear_modulus, state.plastic_strain, inc.dt, t_star);
+            detail::model_return(strength, trial, m.shear_modulus, state.plastic_strain, inc.dt, t_star);
+        if (r.iterations > johnson_cook_max_iterations) {
+            PointResult not_converged = fault(PointFault::return_not_converged);
+            not_converged.return_iterations = r.iterations;
+            return not_converged;
+        }
         s_new = r.deviator;
         return_iterations = r.iterations;
         plastic_increment = r.plastic_strain_increment;
@@ -114,7 +139,8 @@ PointResult update_point(const Material& m, PointState& state, const PointIncrem
     const double q_mid = 0.5 * (inc.viscous_pressure_old + inc.viscous_pressure_new);
     const double deviatoric_work = inc.dt / rho_mid * (0.5 * (s_old + s_new)).cwiseProduct(d_dev).sum();
 
-    const detail::EosTerms eos = detail::eos_terms(m.eos, m.density, rho_new);
+    const detail::EosTerms eos = detail::model_terms(eos_model, m.density, rho_new);
+    if (eos.beyond_limit) return fault(PointFault::eos_limit);
     double energy = state.specific_internal_energy;
     double pressure = 0.0;
     if (inc.energy_booked_by_caller) {
@@ -126,18 +152,13 @@ PointResult update_point(const Material& m, PointState& state, const PointIncrem
     } else {
         // e_new = known - (a + b e_new) dv / 2  =>  e_new (1 + b dv / 2) = known - a dv / 2.
         const double known = state.specific_internal_energy + deviatoric_work - (0.5 * state.pressure + q_mid) * dv;
-        const double denominator = 1.0 + 0.5 * eos.b * dv;
+        const double denominator = energy_solve_denominator(eos.b, inc);
         // b = Gamma0 rho0 (Mie-Grueneisen), so 1 + b dv / 2 falls to 1/2 when one step shrinks the
         // specific volume by v0 / Gamma0: half the initial specific volume for Gamma0 = 2, out of
         // reach of an explicit step at about the initial density, but only a sixth of the volume of
         // a failed node expanded to a third of it (a fragment cloud of a hypervelocity impact).
         // The trapezoidal solve is then no longer a fair approximation: refuse it, naming the step.
-        if (!(denominator > 0.5)) {
-            throw std::domain_error(fmt::format(
-                "point update: compression {} -> {} kg/m^3 in one step is too large for the energy solve "
-                "(1 + b dv / 2 = {}); the compatible energy update (solver.energy_update) has no such limit",
-                rho_old, rho_new, denominator));
-        }
+        if (!(denominator > 0.5)) return fault(PointFault::energy_solve);
         energy = (known - 0.5 * eos.a * dv) / denominator;
         pressure = eos.a + eos.b * energy;
         if (state.failed && pressure < 0.0) {
@@ -153,7 +174,7 @@ PointResult update_point(const Material& m, PointState& state, const PointIncrem
     }
 
     // 7. Damage and failure.
-    const double reference_bulk = detail::reference_bulk_modulus(m.eos, m.density);
+    const double reference_bulk = model.reference_bulk_modulus();
     PointResult result;
     if (inc.failure_enabled && !state.failed) {
         if (m.failure.johnson_cook && plastic_increment > 0.0) {
@@ -185,6 +206,48 @@ PointResult update_point(const Material& m, PointState& state, const PointIncrem
     result.viscous_work = inc.energy_booked_by_caller ? 0.0 : -q_mid * dv;
     result.plastic_strain_rate = plastic_rate;
     result.return_iterations = return_iterations;
+    return result;
+}
+
+}  // namespace
+
+PointModel::PointModel(const Material& material)
+    : material_(&material),
+      reference_bulk_(detail::reference_bulk_modulus(material.eos, material.density)),
+      update_(std::visit(
+          [](const auto& eos, const auto& strength) -> Update {
+              return &update_with<std::decay_t<decltype(eos)>, std::decay_t<decltype(strength)>>;
+          },
+          material.eos, material.strength)) {}
+
+std::string PointModel::fault_message(const PointState& state, const PointIncrement& inc, const PointResult& result) const {
+    const Material& m = *material_;
+    switch (result.fault) {
+        case PointFault::none:
+            return {};
+        case PointFault::bad_increment:
+            return increment_message(inc);
+        case PointFault::eos_limit:
+            return detail::eos_limit_message(std::get<MieGruneisenEos>(m.eos), m.density, inc.density_new);
+        case PointFault::energy_solve:
+            return fmt::format(
+                "point update: compression {} -> {} kg/m^3 in one step is too large for the energy solve "
+                "(1 + b dv / 2 = {}); the compatible energy update (solver.energy_update) has no such limit",
+                inc.density_old, inc.density_new,
+                energy_solve_denominator(detail::eos_terms(m.eos, m.density, inc.density_new).b, inc));
+        case PointFault::return_not_converged:
+            return fmt::format(
+                "the Johnson-Cook return did not converge in {} iterations (plastic strain {:.6g}, temperature {:.6g} K, "
+                "time step {:.3g} s)",
+                johnson_cook_max_iterations, state.plastic_strain, state.temperature, inc.dt);
+    }
+    return "point update: unknown fault";
+}
+
+PointResult update_point(const Material& m, PointState& state, const PointIncrement& inc) {
+    const PointModel model(m);
+    const PointResult result = model.update(state, inc);
+    if (result.fault != PointFault::none) throw std::domain_error(model.fault_message(state, inc, result));
     return result;
 }
 

@@ -146,35 +146,44 @@ ReturnResult johnson_cook_return(const JohnsonCookStrength& jc, const Eigen::Mat
 // along itself onto the yield surface; the plastic strain increment satisfies
 // sigma_eq* - 3 G d eps_p = Y(eps_p + d eps_p). Y = 0 at and above melt for both plastic models
 // (materials.md). With G = 0 no elastic strain exists to turn plastic: the deviator is only
-// scaled back and d eps_p = 0.
-ReturnResult radial_return(const Strength& strength, const Eigen::Matrix3d& trial, double shear_modulus,
-                           double plastic_strain, double dt, double homologous_temperature) {
+// scaled back and d eps_p = 0. One overload per strength model; radial_return visits them.
+
+// An elastic material: no return.
+ReturnResult model_return(const ElasticStrength&, const Eigen::Matrix3d& trial, double, double, double, double) {
     ReturnResult elastic;
     elastic.deviator = trial;
-    if (std::holds_alternative<ElasticStrength>(strength)) {
-        return elastic;
-    }
+    return elastic;
+}
+
+// Linear hardening Y(eps_p) = Y0 + H eps_p: the consistency condition
+// sigma_eq* - 3 G x = Y0 + H (eps_p + x) is linear in x = d eps_p, so
+// x = (sigma_eq* - Y(eps_p)) / (3 G + H) exactly (H = 0: perfect plasticity).
+ReturnResult model_return(const VonMisesStrength& vm, const Eigen::Matrix3d& trial, double shear_modulus,
+                          double plastic_strain, double, double homologous_temperature) {
+    ReturnResult elastic;
+    elastic.deviator = trial;
     const double t_star = std::clamp(homologous_temperature, 0.0, 1.0);
     const double trial_equivalent = von_mises(trial);
-
-    if (const auto* vm = std::get_if<VonMisesStrength>(&strength)) {
-        // Linear hardening Y(eps_p) = Y0 + H eps_p: the consistency condition
-        // sigma_eq* - 3 G x = Y0 + H (eps_p + x) is linear in x = d eps_p, so
-        // x = (sigma_eq* - Y(eps_p)) / (3 G + H) exactly (H = 0: perfect plasticity).
-        const double h = vm->hardening_modulus;
-        const double y = t_star >= 1.0 ? 0.0 : vm->yield_stress + h * plastic_strain;
-        elastic.flow_stress = y;
-        if (!(trial_equivalent > y)) {
-            return elastic;
-        }
-        if (!(shear_modulus > 0.0)) return project(trial, trial_equivalent, y, 0.0);
-        // Molten (Y = 0 whatever eps_p): the whole trial deviator returns, without hardening.
-        const double slope = t_star >= 1.0 ? 0.0 : h;
-        const double increment = (trial_equivalent - y) / (3.0 * shear_modulus + slope);
-        return project(trial, trial_equivalent, y + slope * increment, increment);
+    const double h = vm.hardening_modulus;
+    const double y = t_star >= 1.0 ? 0.0 : vm.yield_stress + h * plastic_strain;
+    elastic.flow_stress = y;
+    if (!(trial_equivalent > y)) {
+        return elastic;
     }
+    if (!(shear_modulus > 0.0)) return project(trial, trial_equivalent, y, 0.0);
+    // Molten (Y = 0 whatever eps_p): the whole trial deviator returns, without hardening.
+    const double slope = t_star >= 1.0 ? 0.0 : h;
+    const double increment = (trial_equivalent - y) / (3.0 * shear_modulus + slope);
+    return project(trial, trial_equivalent, y + slope * increment, increment);
+}
 
-    const auto& jc = std::get<JohnsonCookStrength>(strength);
+// Johnson-Cook: the iteration of johnson_cook_return from the flow stress at the start of the step.
+ReturnResult model_return(const JohnsonCookStrength& jc, const Eigen::Matrix3d& trial, double shear_modulus,
+                          double plastic_strain, double dt, double homologous_temperature) {
+    ReturnResult elastic;
+    elastic.deviator = trial;
+    const double t_star = std::clamp(homologous_temperature, 0.0, 1.0);
+    const double trial_equivalent = von_mises(trial);
     const double y0 = johnson_cook_flow(jc, plastic_strain, 0.0, t_star).stress;  // no plastic flow yet: no rate term
     elastic.flow_stress = y0;
     if (!(trial_equivalent > y0)) {
@@ -184,6 +193,13 @@ ReturnResult radial_return(const Strength& strength, const Eigen::Matrix3d& tria
         return project(trial, trial_equivalent, y0, 0.0);
     }
     return johnson_cook_return(jc, trial, trial_equivalent, shear_modulus, plastic_strain, dt, t_star, y0);
+}
+
+ReturnResult radial_return(const Strength& strength, const Eigen::Matrix3d& trial, double shear_modulus,
+                           double plastic_strain, double dt, double homologous_temperature) {
+    return std::visit(
+        [&](const auto& model) { return model_return(model, trial, shear_modulus, plastic_strain, dt, homologous_temperature); },
+        strength);
 }
 
 }  // namespace detail

@@ -392,5 +392,75 @@ TEST(PointUpdate, PoleGuardPropagates) {
     }
 }
 
+TEST(PointModel, EachFaultLeavesTheStateAsItWasAndSaysWhyAsUpdatePointDoes) {
+    // PointModel::update never throws: for each fault it returns PointResult::fault with the state
+    // untouched, and fault_message gives the words update_point throws for the same point.
+    const Material m = test::copper();
+    PointState start;
+    start.deviatoric_stress = {1e7, -4e6, -6e6, 0.0, 0.0, 3e6};
+    start.pressure = 2e8;
+    start.specific_internal_energy = 5e3;
+    start.plastic_strain = 0.1;
+    start.temperature = 320.0;
+    start.damage = 0.2;
+    const auto same = [](const PointState& a, const PointState& b) {
+        return a.deviatoric_stress == b.deviatoric_stress && a.pressure == b.pressure &&
+               a.specific_internal_energy == b.specific_internal_energy && a.plastic_strain == b.plastic_strain &&
+               a.temperature == b.temperature && a.damage == b.damage && a.failed == b.failed;
+    };
+    struct Case {
+        const char* name;
+        PointFault fault;
+        PointIncrement inc;
+        bool failed = false;
+        const char* words;
+    };
+    std::vector<Case> cases;
+    PointIncrement bad;
+    bad.dt = 1e-8;
+    bad.density_old = m.density;
+    bad.density_new = -1.0;
+    cases.push_back({"negative density", PointFault::bad_increment, bad, false, "must be positive and finite"});
+    PointIncrement pole;
+    pole.dt = 1e-8;
+    pole.density_old = m.density;
+    pole.density_new = 3.0 * m.density;  // mu = 2 beyond the guard at 1.84
+    pole.velocity_gradient = isotropic(pole.density_old, pole.density_new, pole.dt);
+    cases.push_back({"beyond the Hugoniot pole", PointFault::eos_limit, pole, false, "Hugoniot pole"});
+    PointIncrement crushed;  // a failed node of a fragment cloud (see the Energy test above)
+    crushed.dt = 1.6e-9;
+    crushed.density_old = m.density / 3.0;
+    crushed.density_new = 1.29 * crushed.density_old;
+    crushed.velocity_gradient = isotropic(crushed.density_old, crushed.density_new, crushed.dt);
+    cases.push_back({"one step too large for the energy solve", PointFault::energy_solve, crushed, true,
+                     "too large for the energy solve"});
+    const PointModel model(m);
+    for (const Case& c : cases) {
+        PointState state = start;
+        state.failed = c.failed;
+        const PointState before = state;
+        const PointResult r = model.update(state, c.inc);
+        EXPECT_EQ(r.fault, c.fault) << c.name;
+        EXPECT_TRUE(same(state, before)) << c.name << ": the state changed";
+        const std::string message = model.fault_message(state, c.inc, r);
+        EXPECT_NE(message.find(c.words), std::string::npos) << c.name << ": " << message;
+        try {
+            update_point(m, state, c.inc);
+            ADD_FAILURE() << c.name << ": update_point must throw";
+        } catch (const std::domain_error& e) {
+            EXPECT_EQ(std::string(e.what()), message) << c.name;
+        }
+        EXPECT_TRUE(same(state, before)) << c.name << ": update_point changed the state";
+    }
+    PointState state = start;
+    PointIncrement fine = pole;
+    fine.density_new = 1.01 * m.density;
+    fine.velocity_gradient = isotropic(fine.density_old, fine.density_new, fine.dt);
+    const PointResult r = model.update(state, fine);
+    EXPECT_EQ(r.fault, PointFault::none);
+    EXPECT_EQ(model.fault_message(state, fine, r), "");
+    EXPECT_FALSE(same(state, start));  // it advanced
+}
+
 }  // namespace
 }  // namespace gpa::materials

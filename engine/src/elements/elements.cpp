@@ -473,7 +473,7 @@ void ElementPart::update_stress_in(double dt, std::size_t step, double time) {
     const MaterialPointFields fields = material_point_fields(p, 4);
     FirstPointFailure inverted, failed;  // indexed by triangle
     for (std::size_t mat = 0; mat < groups_.size(); ++mat) {
-        const materials::Material& material = scene_.materials[mat];
+        const materials::PointModel model(scene_.materials[mat]);  // the material's models, chosen once for its group
         const auto& members = groups_[mat];
         tbb::parallel_for(tbb::blocked_range<std::size_t>(0, members.size(), quad_grain), [&](const tbb::blocked_range<std::size_t>& r) {
             for (std::size_t j = r.begin(); j != r.end(); ++j) {
@@ -535,10 +535,9 @@ void ElementPart::update_stress_in(double dt, std::size_t step, double time) {
                     inc.viscous_pressure_old = p.viscous_pressure[i];
                     inc.viscous_pressure_new = q_new;
                     inc.failure_enabled = options_.failure;
-                    try {
-                        advance_material_point<2>(fields, i, material, inc);
-                    } catch (const std::exception& e) {
-                        failed.record(i, e.what());
+                    const materials::PointResult result = advance_material_point<2>(fields, i, model, inc);
+                    if (result.fault != materials::PointFault::none) {
+                        failed.record(i, point_fault_message<2>(fields, i, model, inc, result));
                         continue;
                     }
                     p.viscous_pressure[i] = q_new;

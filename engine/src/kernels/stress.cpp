@@ -23,7 +23,7 @@ Eigen::Matrix3d full_velocity_gradient(const NodeStore& nodes, std::size_t i) {
     for (int a = 0; a < D; ++a) {
         for (int b = 0; b < D; ++b) L(a, b) = nodes.velocity_gradient[a * D + b][i];
     }
-    if constexpr (G::axisymmetric) L(2, 2) = nodes.velocity[0][i] / nodes.position[0][i];  // Eq. 9
+    if constexpr (G::axisymmetric) L(2, 2) = hoop_strain_rate(nodes.velocity[0][i], nodes.position[0][i]);
     return L;
 }
 
@@ -58,10 +58,10 @@ constexpr std::size_t no_node = std::numeric_limits<std::size_t>::max();
 
 }  // namespace
 
+namespace {
+
 template <int D>
-materials::PointResult advance_material_point(const MaterialPointFields& f, std::size_t i,
-                                              const materials::Material& material,
-                                              const materials::PointIncrement& increment) {
+materials::PointState point_state(const MaterialPointFields& f, std::size_t i) {
     materials::PointState state;
     state.deviatoric_stress = to_material<D>(f, i);
     state.pressure = f.pressure[i];
@@ -70,14 +70,17 @@ materials::PointResult advance_material_point(const MaterialPointFields& f, std:
     state.temperature = f.temperature[i];
     state.damage = f.damage[i];
     state.failed = f.failed[i] != 0;
-    const materials::PointResult result = materials::update_point(material, state, increment);
-    if (result.return_iterations > materials::johnson_cook_max_iterations) {
-        // The callers report the first such node after their loop (update_stresses, elements.cpp).
-        throw std::runtime_error(fmt::format(
-            "the Johnson-Cook return did not converge in {} iterations (plastic strain {:.6g}, temperature {:.6g} K, "
-            "time step {:.3g} s)",
-            materials::johnson_cook_max_iterations, f.plastic_strain[i], f.temperature[i], increment.dt));
-    }
+    return state;
+}
+
+}  // namespace
+
+template <int D>
+materials::PointResult advance_material_point(const MaterialPointFields& f, std::size_t i, const materials::PointModel& model,
+                                              const materials::PointIncrement& increment) {
+    materials::PointState state = point_state<D>(f, i);
+    const materials::PointResult result = model.update(state, increment);
+    if (result.fault != materials::PointFault::none) return result;  // the fields stay as they were
     from_material<D>(f, i, state.deviatoric_stress);
     f.pressure[i] = state.pressure;
     f.internal_energy[i] = state.specific_internal_energy;
@@ -89,6 +92,12 @@ materials::PointResult advance_material_point(const MaterialPointFields& f, std:
     f.plastic_work[i] += result.plastic_work;
     f.viscous_work[i] += result.viscous_work;
     return result;
+}
+
+template <int D>
+std::string point_fault_message(const MaterialPointFields& f, std::size_t i, const materials::PointModel& model,
+                                const materials::PointIncrement& increment, const materials::PointResult& result) {
+    return model.fault_message(point_state<D>(f, i), increment, result);
 }
 
 InitialPointState initial_material_point(const materials::Material& material, double density,
@@ -111,10 +120,10 @@ void update_stresses(NodeStore& nodes, std::size_t real_count, const std::vector
                      const std::vector<std::vector<NodeIndex>>& groups, double dt, const StressPhaseOptions& options) {
     constexpr int D = G::dim;
     std::atomic<std::size_t> collapsed{no_node};
-    FirstPointFailure failure;  // taken only when a material update throws
+    FirstPointFailure failure;  // taken only when a point update reports a fault
     const MaterialPointFields fields = material_point_fields(nodes, stress_components(nodes.dim()));
     for (std::size_t m = 0; m < groups.size(); ++m) {
-        const materials::Material& material = materials.at(m);
+        const materials::PointModel model(materials.at(m));  // the material's models, chosen once for its group
         const auto& members = groups[m];
         // 64 points per task: a point update takes some 0.1-0.5 us, so a task is tens of microseconds
         // and a body of 10^3 nodes still splits among the threads (each point is its own).
@@ -148,10 +157,9 @@ void update_stresses(NodeStore& nodes, std::size_t real_count, const std::vector
                 inc.viscous_pressure_new = q_new;
                 inc.energy_booked_by_caller = options.energy_booked_by_forces;
                 inc.failure_enabled = options.failure;
-                try {
-                    advance_material_point<D>(fields, i, material, inc);
-                } catch (const std::exception& e) {
-                    failure.record(i, e.what());
+                const materials::PointResult result = advance_material_point<D>(fields, i, model, inc);
+                if (result.fault != materials::PointFault::none) {
+                    failure.record(i, point_fault_message<D>(fields, i, model, inc, result));
                     continue;
                 }
                 nodes.volumetric_strain[i] = eps_v;
@@ -197,9 +205,13 @@ template void update_stresses<ThreeD>(NodeStore&, std::size_t, const std::vector
 template Eigen::Matrix3d full_velocity_gradient<PlaneStrain>(const NodeStore&, std::size_t);
 template Eigen::Matrix3d full_velocity_gradient<Axisymmetric>(const NodeStore&, std::size_t);
 template Eigen::Matrix3d full_velocity_gradient<ThreeD>(const NodeStore&, std::size_t);
-template materials::PointResult advance_material_point<2>(const MaterialPointFields&, std::size_t, const materials::Material&,
+template materials::PointResult advance_material_point<2>(const MaterialPointFields&, std::size_t, const materials::PointModel&,
                                                           const materials::PointIncrement&);
-template materials::PointResult advance_material_point<3>(const MaterialPointFields&, std::size_t, const materials::Material&,
+template materials::PointResult advance_material_point<3>(const MaterialPointFields&, std::size_t, const materials::PointModel&,
                                                           const materials::PointIncrement&);
+template std::string point_fault_message<2>(const MaterialPointFields&, std::size_t, const materials::PointModel&,
+                                            const materials::PointIncrement&, const materials::PointResult&);
+template std::string point_fault_message<3>(const MaterialPointFields&, std::size_t, const materials::PointModel&,
+                                            const materials::PointIncrement&, const materials::PointResult&);
 
 }  // namespace gpa

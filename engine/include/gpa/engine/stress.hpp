@@ -28,8 +28,9 @@ struct StressPhaseOptions {
 
 // Advances nodes [0, real_count) over dt from the velocity gradient of the gradient phase.
 // `groups[m]` lists the nodes of material m (each node in exactly one group); the material's
-// models are dispatched once per group. Throws NumericalError naming the node when a volume
-// collapses (V <= 0) or a state stops being finite.
+// models are chosen once per group (materials::PointModel). Throws NumericalError naming the node
+// when a volume collapses (V <= 0) or a point update reports a fault (the smallest such node, after
+// the loop, with the update's words; that node is left as it was).
 template <class G>
 void update_stresses(NodeStore& nodes, std::size_t real_count, const std::vector<materials::Material>& materials,
                      const std::vector<std::vector<NodeIndex>>& groups, double dt, const StressPhaseOptions& options);
@@ -48,7 +49,7 @@ void initialise_material_state(NodeStore& nodes, std::size_t real_count,
 //
 // Particle nodes (NodeStore) and the triangles of element bodies (elements.hpp) keep the same
 // material state as structure-of-arrays fields; both present them as MaterialPointFields, so that
-// both go through one update (advance_material_point, which calls materials::update_point) and
+// both go through one update (advance_material_point, with the PointModel of the material) and
 // one start state (initial_material_point). What differs is only how each finds its velocity
 // gradient, densities and viscous pressure (spec section 3 for nodes, docs/elements.md for
 // elements).
@@ -86,14 +87,20 @@ MaterialPointFields material_point_fields(Store& store, int components) {
     return f;
 }
 
-// Advances point i over the increment with materials::update_point and writes the new state back
-// (deviator, pressure, energy, plastic strain, temperature, damage, failure, sound speed, and the
-// plastic and viscous work added to their totals). D is the dimension of the stress order. Throws
-// what update_point throws, with the state untouched.
+// Advances point i over the increment with the material's point update (materials::PointModel,
+// made once per material group) and writes the new state back (deviator, pressure, energy, plastic
+// strain, temperature, damage, failure, sound speed, and the plastic and viscous work added to their
+// totals). D is the dimension of the stress order. Never throws: a point the update cannot advance
+// comes back with its PointResult::fault set and its fields untouched, for the caller to record
+// (point_fault_message) and report after its loop.
 template <int D>
-materials::PointResult advance_material_point(const MaterialPointFields& f, std::size_t i,
-                                              const materials::Material& material,
+materials::PointResult advance_material_point(const MaterialPointFields& f, std::size_t i, const materials::PointModel& model,
                                               const materials::PointIncrement& increment);
+
+// The words for a fault of advance_material_point at point i (whose fields it left untouched).
+template <int D>
+std::string point_fault_message(const MaterialPointFields& f, std::size_t i, const materials::PointModel& model,
+                                const materials::PointIncrement& increment, const materials::PointResult& result);
 
 // The state of an unloaded point at `density`: pressure from the equation of state at e = 0 and
 // the longitudinal sound speed sqrt((K + 4 G / 3) / rho) (K floored at 0).

@@ -8,6 +8,7 @@
 // threads or files. Units are SI (Pa, m, s, kg, K, J).
 
 #include <array>
+#include <cstdint>
 #include <limits>
 #include <optional>
 #include <string>
@@ -149,15 +150,26 @@ struct PointIncrement {
     bool energy_booked_by_caller = false;
 };
 
+// Why a point update could not advance a point (PointResult::fault). The point's state is then
+// left as it was passed in, and PointModel::fault_message says what went wrong in words.
+enum class PointFault : std::uint8_t {
+    none,
+    bad_increment,         // a density that is not positive and finite, or a negative or non-finite time step
+    eos_limit,             // compression at or beyond the Mie-Grueneisen guard short of the Hugoniot pole (eos.cpp)
+    energy_solve,          // one step's compression too large for the point's own energy solve (point_update.cpp)
+    return_not_converged,  // the Johnson-Cook return reached johnson_cook_max_iterations (strength.cpp)
+};
+
 struct PointResult {
+    PointFault fault = PointFault::none;  // none: the point advanced
     double sound_speed = 0.0;       // longitudinal, sqrt((K_s + 4 G / 3) / rho), G = 0 when failed or molten
     double plastic_work = 0.0;      // increment of specific plastic work over the step, J/kg
     double viscous_work = 0.0;      // increment of specific work done by Q over the step, J/kg (>= 0 in compression)
     double plastic_strain_rate = 0.0;  // equivalent plastic strain rate d eps_p / dt of the step, 1/s
     bool failed_now = false;        // the node failed during this step
     // Flow-stress evaluations of the Johnson-Cook return (0 for other strengths and elastic steps);
-    // johnson_cook_max_iterations + 1 when the return did not converge within its cap (the caller
-    // reports that: the deviator is then not on the yield surface).
+    // johnson_cook_max_iterations + 1 when the return did not converge within its cap (then the
+    // fault is return_not_converged: the deviator would not lie on the yield surface).
     int return_iterations = 0;
 };
 
@@ -172,6 +184,36 @@ inline constexpr int johnson_cook_max_iterations = 200;
 //     (rho_new, e_new), solved exactly because every EOS here is linear in e;
 //   temperature: T += beta dW_p / c_p; damage: D += d eps_p / eps_f;
 //   failure (if enabled): D >= 1 or P < -P_spall; a failed point keeps no deviator and no tension.
+// Throws std::domain_error with PointModel::fault_message when the point cannot be advanced (the
+// faults of PointFault), the state then unchanged. A convenience for single points: a loop over many
+// points of one material makes a PointModel once and calls its update.
 PointResult update_point(const Material& m, PointState& state, const PointIncrement& inc);
+
+// A material with its models chosen once: the equation of state and the strength model are looked
+// up when the PointModel is made, not at every point, and the constants every point needs (the
+// reference bulk modulus of the sound-speed floor) are worked out then. The engine makes one per
+// material group and stress update; the points of the group then run code compiled for their models,
+// with no branch on the model and no exception. Refers to the material, which must outlive it.
+class PointModel {
+public:
+    explicit PointModel(const Material& material);
+
+    // The point update of update_point, without exceptions: a point that cannot be advanced comes
+    // back with PointResult::fault set and its state unchanged.
+    PointResult update(PointState& state, const PointIncrement& inc) const noexcept { return update_(*this, state, inc); }
+
+    // The words for a fault that update() returned for this state (as passed in, so unchanged) and
+    // increment: what went wrong, with the values that show it. Empty when result.fault is none.
+    std::string fault_message(const PointState& state, const PointIncrement& inc, const PointResult& result) const;
+
+    const Material& material() const { return *material_; }
+    double reference_bulk_modulus() const { return reference_bulk_; }  // K, K1 or rho0 c0^2, Pa
+
+private:
+    using Update = PointResult (*)(const PointModel&, PointState&, const PointIncrement&) noexcept;
+    const Material* material_;
+    double reference_bulk_;
+    Update update_;
+};
 
 }  // namespace gpa::materials

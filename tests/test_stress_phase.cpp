@@ -1,0 +1,147 @@
+// The stress phase (stress.hpp, update_stresses): each material group runs its point update with the
+// models chosen once (materials::PointModel); a point the update cannot advance is recorded in the
+// loop without an exception, left as it was, and reported after the loop by the smallest index, so
+// that the error does not depend on the thread count.
+
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include "gpa/engine/errors.hpp"
+#include "gpa/engine/kernels.hpp"
+#include "gpa/engine/lattice.hpp"
+#include "gpa/engine/stress.hpp"
+
+namespace gpa {
+namespace {
+
+// OFHC copper with the Mie-Grueneisen EOS (materials.md): its compression guard short of the
+// Hugoniot pole is at mu = 0.9 / (s - 1) = 1.84.
+materials::Material copper() {
+    materials::Material m;
+    m.name = "copper";
+    m.density = 8930.0;
+    m.shear_modulus = 46e9;
+    m.specific_heat = 383.0;
+    m.melt_temperature = 1356.0;
+    m.eos = materials::MieGruneisenEos{3940.0, 1.489, 2.02};
+    m.strength = materials::JohnsonCookStrength{90e6, 292e6, 0.31, 0.025, 1.09, 1.0};
+    return m;
+}
+
+struct Block {
+    NodeStore nodes{GeometryKind::PlaneStrain};
+    std::vector<materials::Material> materials{copper()};
+    std::vector<std::vector<NodeIndex>> groups;
+};
+
+// A 4 x 4 block of copper in plane strain, sheared at 1e5 1/s (every point yields within a few steps
+// of 10 ns) and with the volumetric strain rates given.
+Block sheared_block(const std::vector<std::pair<std::size_t, double>>& compressed) {
+    Block b;
+    LatticeBlock lattice;
+    lattice.spacing = {1e-3, 1e-3, 0.0};
+    lattice.last = {4, 4, 1};
+    lattice.density = b.materials[0].density;
+    fill_lattice(b.nodes, lattice);
+    initialise_material_state(b.nodes, b.nodes.size(), b.materials);
+    b.groups.assign(1, {});
+    for (std::size_t i = 0; i < b.nodes.size(); ++i) {
+        b.groups[0].push_back(static_cast<NodeIndex>(i));
+        b.nodes.velocity_gradient[1][i] = 1e5;  // dv_x/dz
+        b.nodes.smallest_h[i] = 1e-3;
+    }
+    for (const auto& [i, rate] : compressed) b.nodes.volumetric_strain_rate[i] = rate;
+    return b;
+}
+
+// Every field a point update writes, of node i.
+std::vector<double> point_fields(const NodeStore& n, std::size_t i) {
+    std::vector<double> out{n.pressure[i],   n.internal_energy[i], n.plastic_strain[i],  n.temperature[i],
+                            n.damage[i],     n.sound_speed[i],     n.plastic_work[i],    n.viscous_work[i],
+                            n.volume[i],     n.volumetric_strain[i], n.viscous_pressure[i], double(n.failed[i])};
+    for (const auto& s : n.deviatoric_stress) {
+        if (!s.empty()) out.push_back(s[i]);
+    }
+    return out;
+}
+
+TEST(StressPhase, APointBeyondItsEquationOfStateIsLeftAsItWasAndNamedAfterTheLoop) {
+    // Nodes 5 and 11 are squeezed to a third of their volume in one step of 10 ns (mu = 2, beyond
+    // copper's guard at 1.84): each point update says so without throwing; the step reports the
+    // smaller index with the update's own words, and leaves both points as they were while every
+    // other point of the group advanced.
+    constexpr double dt = 1e-8;
+    const double rate = (1.0 / 3.0 - 1.0) / dt;  // eps_v = rate dt from 0: V = V0 / 3
+    for (const int threads : {1, 2}) {
+        tbb::global_control limit(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads));
+        Block b = sheared_block({{5, rate}, {11, rate}});
+        const NodeStore before = b.nodes;
+        StressPhaseOptions options;
+        try {
+            update_stresses<PlaneStrain>(b.nodes, b.nodes.size(), b.materials, b.groups, dt, options);
+            FAIL() << "the step must stop at the points beyond the equation of state's guard";
+        } catch (const NumericalError& e) {
+            const std::string what = e.what();
+            ASSERT_TRUE(e.node().has_value());
+            EXPECT_EQ(*e.node(), 5u) << threads << " threads: " << what;
+            EXPECT_NE(what.find("node 5 "), std::string::npos) << what;
+            EXPECT_NE(what.find("material \"copper\""), std::string::npos) << what;
+            EXPECT_NE(what.find("Hugoniot pole"), std::string::npos) << what;  // the EOS's own words
+        }
+        for (std::size_t i = 0; i < b.nodes.size(); ++i) {
+            if (i == 5 || i == 11) {
+                EXPECT_EQ(point_fields(b.nodes, i), point_fields(before, i)) << "node " << i << " was changed";
+            } else {
+                EXPECT_NE(b.nodes.deviatoric_stress[2][i], before.deviatoric_stress[2][i]) << "node " << i << " did not advance";
+            }
+        }
+    }
+}
+
+TEST(StressPhase, OnePointModelPerGroupGivesTheSingleUpdateBitForBit) {
+    // The group loop (one PointModel for the group, no exception) and materials::update_point (a
+    // PointModel per call, throwing) run the same compiled update: the same state to the last bit,
+    // step after step, for a point in plain shear and two compressed or expanded ones (artificial
+    // viscosity off, so that the replay needs no sound-speed history).
+    Block b = sheared_block({{3, -2e4}, {7, 3e4}});
+    const NodeStore start = b.nodes;
+    constexpr double dt = 1e-8;
+    constexpr int steps = 20;
+    StressPhaseOptions options;
+    options.nodal_viscosity = false;
+    for (int step = 0; step < steps; ++step) {
+        update_stresses<PlaneStrain>(b.nodes, b.nodes.size(), b.materials, b.groups, dt, options);
+    }
+    for (const std::size_t i : {std::size_t{0}, std::size_t{3}, std::size_t{7}}) {
+        materials::PointState state;
+        state.pressure = start.pressure[i];
+        state.temperature = start.temperature[i];
+        double eps_v = 0.0;
+        double volume = start.volume[i];
+        for (int step = 0; step < steps; ++step) {
+            eps_v = advance_volumetric_strain(eps_v, start.volumetric_strain_rate[i], dt);
+            const double volume_new = start.initial_volume[i] * (1.0 + eps_v);
+            materials::PointIncrement inc;
+            inc.velocity_gradient = full_velocity_gradient<PlaneStrain>(start, i);
+            inc.dt = dt;
+            inc.density_old = start.mass[i] / volume;
+            inc.density_new = start.mass[i] / volume_new;
+            materials::update_point(b.materials[0], state, inc);
+            volume = volume_new;
+        }
+        EXPECT_GT(state.plastic_strain, 0.0) << "node " << i;  // the points flowed
+        EXPECT_EQ(b.nodes.plastic_strain[i], state.plastic_strain) << "node " << i;
+        EXPECT_EQ(b.nodes.pressure[i], state.pressure) << "node " << i;
+        EXPECT_EQ(b.nodes.temperature[i], state.temperature) << "node " << i;
+        EXPECT_EQ(b.nodes.internal_energy[i], state.specific_internal_energy) << "node " << i;
+        EXPECT_EQ(b.nodes.deviatoric_stress[0][i], state.deviatoric_stress[0]) << "node " << i;  // xx
+        EXPECT_EQ(b.nodes.deviatoric_stress[2][i], state.deviatoric_stress[5]) << "node " << i;  // xz: the materials' "xy"
+        EXPECT_EQ(b.nodes.volume[i], volume) << "node " << i;
+    }
+}
+
+}  // namespace
+}  // namespace gpa
