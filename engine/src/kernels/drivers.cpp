@@ -125,12 +125,8 @@ void gradient_impl(const CompressedRows& lists, const GradientFields<G::dim>& f,
                 // Eq. 14-15, 51-53: alpha_b = 1 / sum_j R W l_b^2.
                 Vec<D> alpha;
                 for (int b = 0; b < D; ++b) {
-                    if (sums.moment[b] > 0.0) {
-                        alpha[b] = 1.0 / sums.moment[b];
-                    } else {
-                        alpha[b] = 0.0;
-                        ok &= f.allow_degenerate;
-                    }
+                    alpha[b] = geometry_factor(sums.moment[b]);
+                    if (!(sums.moment[b] > 0.0)) ok &= f.allow_degenerate;
                 }
                 if (f.alpha_limit > 0.0) alpha = alpha.cwiseMin(f.alpha_limit / f.size_weight[i]);
                 normalisation = alpha.asDiagonal();
@@ -271,7 +267,7 @@ void stress_power_impl(const CompressedRows& lists, const ForceFields<G::dim>& f
                 const double hoop = hoop_force(out_of_plane_stress(f.deviatoric_stress, f.pressure, f.viscous_pressure, i), volume,
                                                f.pairs.position[0][i]);
                 sum += hoop * v_i[0];
-                divergence += v_i[0] / f.pairs.position[0][i];
+                divergence += hoop_strain_rate(v_i[0], f.pairs.position[0][i]);
             }
             power[i] = sum;
             viscous_power[i] = q * volume * divergence;

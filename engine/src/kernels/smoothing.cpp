@@ -1,5 +1,7 @@
 #include "gpa/engine/smoothing.hpp"
 
+#include "gpa/engine/kernels.hpp"
+
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
@@ -33,10 +35,9 @@ double smooth_impl(const CompressedRows& lists, const ScatterPlan& plan, const P
             }
             if (!(weight_sum > 0.0) || !(weighted_mass > 0.0)) continue;
             for (int c = 0; c < D; ++c) {
-                scratch.centre_change[D * i + c] = options.coefficient * (weighted_v[c] / weight_sum - v[c][i]);
+                scratch.centre_change[D * i + c] = smoothing_change(options.coefficient, weighted_v[c], weight_sum, v[c][i]);
             }
-            // Eq. 69-72: neighbour j receives - M_i R_ij dv_i / sum_k R_ik M_k.
-            scratch.share[i] = mass[i] / weighted_mass;
+            scratch.share[i] = smoothing_share(mass[i], weighted_mass);
         }
     });
     // Scatter the neighbours' shares by colours (each node receives its changes in plan order).
@@ -71,7 +72,7 @@ double smooth_impl(const CompressedRows& lists, const ScatterPlan& plan, const P
                     after += new_v * new_v;
                     v[c][i] = new_v;
                 }
-                const double dE = 0.5 * mass[i] * (before - after);
+                const double dE = smoothing_heat(mass[i], before, after);
                 internal_energy[i] += dE / mass[i];
                 moved += dE;
             }

@@ -2,13 +2,13 @@
 
 #include <cmath>
 #include <limits>
-#include <numbers>
 #include <string>
 #include <string_view>
 
 #include <fmt/format.h>
 
 #include "gpa/engine/errors.hpp"
+#include "gpa/engine/kernels.hpp"
 #include "gpa/engine/state_io.hpp"
 
 namespace gpa {
@@ -195,10 +195,7 @@ void validate_nodes(const NodeStore& nodes, std::size_t first, std::size_t last)
 
 void update_size_weights(NodeStore& nodes, std::size_t first, std::size_t last) {
     if (nodes.geometry() == GeometryKind::Axisymmetric) {
-        for (std::size_t i = first; i < last; ++i) {
-            // Eq. 4: A = V / (2 pi x)
-            nodes.size_weight[i] = nodes.volume[i] / (2.0 * std::numbers::pi * nodes.position[0][i]);
-        }
+        for (std::size_t i = first; i < last; ++i) nodes.size_weight[i] = ring_section(nodes.volume[i], nodes.position[0][i]);
     } else {
         for (std::size_t i = first; i < last; ++i) nodes.size_weight[i] = nodes.volume[i];
     }

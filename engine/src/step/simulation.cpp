@@ -36,6 +36,7 @@
 #include "step/neighbour_lists.hpp"
 #include "step/measures.hpp"
 #include "step/regions.hpp"
+#include "step/rigid_planes.hpp"
 #include "step/run_control.hpp"
 #include "step/switching.hpp"
 
@@ -53,7 +54,7 @@ struct Simulation::Impl {
     NodeStore nodes;
     std::size_t real = 0;
     GhostSet ghosts;
-    std::vector<std::size_t> rigid_planes;  // ghost-plane index of each rigid plane of the scene
+    RigidPlanes rigid_planes;  // reactions, impulses, the penetration guard (step/rigid_planes.hpp)
     std::vector<std::vector<NodeIndex>> material_groups;
     NeighbourLists neighbour_lists;  // lists, skin cache, scatter plan (step/neighbour_lists.hpp)
     Contact contact;                 // separation and sliding state (step/contact.hpp)
@@ -72,8 +73,6 @@ struct Simulation::Impl {
     double dt_next = 0.0;  // dt^{n+3/2}
     std::size_t steps = 0;
     double node_steps = 0.0;
-    std::vector<double> impulse;
-    std::vector<double> reaction;
     Regions regions;      // prescribed-velocity regions (step/regions.hpp)
     EnergyLedger ledger;  // every booking of work and heat (step/energy_ledger.hpp)
     Totals totals;
@@ -130,7 +129,7 @@ struct Simulation::Impl {
     template <class G>
     void smoothing();
     void sum_totals();
-    const GhostPlane* first_rigid_plane() const { return rigid_planes.empty() ? nullptr : &ghosts.planes()[rigid_planes.front()]; }
+    const GhostPlane* first_rigid_plane() const { return rigid_planes.first(ghosts); }
     void regroup_materials();
 };
 
@@ -140,15 +139,15 @@ void Simulation::Impl::setup() {
     influence.emplace(scene.solver.influence_distance);
     // Planes with ghosts: the axis of an axisymmetric scene first, then the scene's planes.
     std::vector<GhostPlane> planes;
+    std::vector<std::size_t> rigid;
     if (G::axisymmetric) planes.push_back({"axis", 0, 0.0, +1, false, false});
     for (const auto& p : scene.planes) {
-        if (p.kind == PlaneKind::Rigid) rigid_planes.push_back(planes.size());
+        if (p.kind == PlaneKind::Rigid) rigid.push_back(planes.size());
         planes.push_back({p.name, p.axis, p.position, p.side, p.kind == PlaneKind::Rigid && p.lift_off,
                           p.kind == PlaneKind::Rigid});
     }
     ghosts = GhostSet(planes);
-    impulse.assign(rigid_planes.size(), 0.0);
-    reaction.assign(rigid_planes.size(), 0.0);
+    rigid_planes.assign(std::move(rigid));
     const auto mirrors = ghosts.mirror_planes();
     for (std::size_t b = 0; b < scene.bodies.size(); ++b) {
         if (scene.bodies[b].discretisation == Discretisation::Particles) add_body_nodes(nodes, scene, b, mirrors);
@@ -222,39 +221,12 @@ void Simulation::Impl::move() {
         for (int c = 0; c < d; ++c) {
             double* x = nodes.position[c].data();
             const double* v = nodes.velocity[c].data();
-            for (std::size_t i = r.begin(); i != r.end(); ++i) x[i] += dt * v[i];
+            for (std::size_t i = r.begin(); i != r.end(); ++i) x[i] = leapfrog_position(x[i], v[i], dt);
         }
     });
     regions.advance_displacements(dim(), time, dt);
     time += dt;
-    // Penetration guard: a node that ends behind a plane is put back just in front of it and
-    // loses its velocity towards it; the kinetic energy and momentum it loses are booked as
-    // boundary work and plane impulse (spec section 7).
-    // (In parallel, with sums of a fixed order, so that they do not depend on the thread count.)
-    for (std::size_t p = 0; p < ghosts.planes().size(); ++p) {
-        const auto& plane = ghosts.planes()[p];
-        const auto rigid = std::find(rigid_planes.begin(), rigid_planes.end(), p);
-        using WorkAndImpulse = std::array<double, 2>;
-        const WorkAndImpulse lost = tbb::parallel_deterministic_reduce(
-            tbb::blocked_range<std::size_t>(0, real, reduce_grain), WorkAndImpulse{0.0, 0.0},
-            [&](const tbb::blocked_range<std::size_t>& r, WorkAndImpulse acc) {
-                for (std::size_t i = r.begin(); i != r.end(); ++i) {
-                    double& x = nodes.position[plane.axis][i];
-                    if (plane.distance(x) > 0.0) continue;
-                    x = plane.position + plane.side * 0.01 * nodes.initial_diameter[i];
-                    double& v = nodes.velocity[plane.axis][i];
-                    if (plane.side * v < 0.0) {
-                        acc[0] += 0.5 * nodes.mass[i] * v * v;
-                        acc[1] -= plane.side * nodes.mass[i] * v;
-                        v = 0.0;
-                    }
-                }
-                return acc;
-            },
-            [](WorkAndImpulse x, const WorkAndImpulse& y) { return WorkAndImpulse{x[0] + y[0], x[1] + y[1]}; });
-        ledger.add_boundary_work(lost[0]);
-        if (rigid != rigid_planes.end()) impulse[rigid - rigid_planes.begin()] += lost[1];
-    }
+    rigid_planes.guard_penetration(ghosts, nodes, real, ledger);  // spec section 7
 }
 
 template <class G>
@@ -331,12 +303,9 @@ void Simulation::Impl::time_step() {
         tbb::blocked_range<std::size_t>(0, real, reduce_grain), std::numeric_limits<double>::infinity(),
         [&](const tbb::blocked_range<std::size_t>& r, double best) {
             for (std::size_t i = r.begin(); i != r.end(); ++i) {
-                const double h = nodes.stable_length[i];
-                const double density = nodes.mass[i] / nodes.volume[i];
                 const double q = std::max(nodes.viscous_pressure[i], largest_bond_q.empty() ? 0.0 : largest_bond_q[i]);
-                const double closing = closing_speed ? closing_speed[i] : 0.0;
-                const double speed = nodes.sound_speed[i] + std::sqrt(std::max(q, 0.0) / density) + closing;
-                double local = h / speed;
+                double local = stable_time_step(nodes.stable_length[i], nodes.sound_speed[i], q, nodes.mass[i] / nodes.volume[i],
+                                                closing_speed ? closing_speed[i] : 0.0);
                 const double rate = nodes.volumetric_strain_rate[i];
                 if (volume_limit > 0.0 && (rate < 0.0 || nodes.pressure[i] > 0.0) && std::abs(rate) > 0.0) {
                     local = std::min(local, volume_limit / std::abs(rate));
@@ -398,10 +367,7 @@ void Simulation::Impl::forces() {
         ledger.keep_hourglass_fits<G::dim>(control, real);
         apply_hourglass_control<G::dim>(lists(), plan(), control, real, scene.solver.hourglass_coefficient);
     }
-    if (!ghosts.empty()) {
-        const auto all = ghosts.normal_reactions(nodes, real);
-        for (std::size_t k = 0; k < rigid_planes.size(); ++k) reaction[k] = all[rigid_planes[k]];
-    }
+    rigid_planes.take_reactions(ghosts, nodes, real);
 }
 
 template <class G>
@@ -430,13 +396,13 @@ void Simulation::Impl::integrate(double dt_avg) {
         for (int c = 0; c < d; ++c) {
             double* v = nodes.velocity[c].data();
             const double* f = nodes.force[c].data();
-            for (std::size_t i = r.begin(); i != r.end(); ++i) v[i] += dt_avg * f[i] / nodes.mass[i];
+            for (std::size_t i = r.begin(); i != r.end(); ++i) v[i] = leapfrog_velocity(v[i], f[i], nodes.mass[i], dt_avg);
         }
     });
     if (!held.empty()) {
         regions.book(held.impose(scene.prescribed_velocities, d, time + 0.5 * dt_next, dt_avg, velocity, nodes.mass.data()), dt_avg);
     }
-    for (std::size_t k = 0; k < reaction.size(); ++k) impulse[k] += reaction[k] * dt_avg;
+    rigid_planes.add_impulses(dt_avg);
     if (ledger.compatible() && particles) {
         auto f = force_fields<G::dim>(nodes, a());
         f.pairs = contact.fields(f.pairs, nodes);
@@ -529,12 +495,8 @@ void Simulation::Impl::sum_totals() {
     totals.failed_nodes = s.failed;
     totals.pairs = lists().entries();
     totals.neighbour_searches = neighbour_lists.searches();
-    totals.planes.clear();
-    for (std::size_t k = 0; k < rigid_planes.size(); ++k) {
-        const double element_reaction = elements ? elements->reactions()[k] : 0.0;
-        const double element_impulse = elements ? elements->impulses()[k] : 0.0;
-        totals.planes.push_back({ghosts.planes()[rigid_planes[k]].name, reaction[k] + element_reaction, impulse[k] + element_impulse});
-    }
+    rigid_planes.report(ghosts, elements ? &elements->reactions() : nullptr, elements ? &elements->impulses() : nullptr,
+                        totals.planes);
     measures.body_totals(scene, nodes, real, true, &s, totals.bodies);
     totals.energy_given = totals.initial_energy + std::max(0.0, region_work_now);
     if (totals.energy_given != 0.0) {
@@ -737,8 +699,7 @@ void Simulation::Impl::write_state(StateWriter& out) const {
     out.value<double>(element_steps);
     out.value<std::uint64_t>(totals.bodies.size());
     for (const auto& b : totals.bodies) out.value<double>(b.kinetic_energy);
-    out.array(impulse);
-    out.array(reaction);
+    rigid_planes.write_state(out);
     measures.write_state(out);
     ledger.write_state(out);
     regions.write_state(out);
@@ -799,10 +760,8 @@ void Simulation::Impl::read_state(StateReader& in) {
     std::vector<double> body_kinetic(static_cast<std::size_t>(in.value<std::uint64_t>()));
     if (body_kinetic.size() != scene.bodies.size()) in.fail("its bodies are not the scene's");
     for (double& k : body_kinetic) k = in.value<double>();
-    in.array(impulse);
-    in.array(reaction);
+    rigid_planes.read_state(in);
     measures.read_state(in, scene.bodies.size());
-    if (impulse.size() != rigid_planes.size() || reaction.size() != rigid_planes.size()) in.fail("its planes are not the scene's");
     ledger.read_state(in);
     regions.read_state(in);
     if (elements) elements->read_state(in);

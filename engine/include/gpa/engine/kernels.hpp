@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 #include <Eigen/Core>
 
@@ -77,11 +78,24 @@ inline Mat<D> velocity_gradient(const GradientSums<D>& sums, const Mat<D>& norma
     return sums.difference * normalisation;
 }
 
+// Eq. 4: the size weight of an axisymmetric node, its section A = V / (2 pi x) (the volume of its
+// ring over the ring's length). In plane strain and 3D the size weight is the volume itself.
+inline double ring_section(double volume, double radius) { return volume / (2.0 * std::numbers::pi * radius); }
+
+// Eq. 9: the hoop strain rate of an axisymmetric node, D_thetatheta = u / x (radial velocity over
+// radius).
+inline double hoop_strain_rate(double radial_velocity, double radius) { return radial_velocity / radius; }
+
+// Eq. 14-15, 51-53: the geometry factor alpha_b = 1 / sum_j R W l_b^2 of one direction, from that
+// sum (the moment); 0 where the neighbourhood gives no moment in that direction (the caller decides
+// whether that is allowed).
+inline double geometry_factor(double moment) { return moment > 0.0 ? 1.0 / moment : 0.0; }
+
 // Eq. 12: eps_v_dot = D_xx + D_zz (+ u/x in axisymmetric geometry, Eq. 9) or the trace in 3D.
 template <class G>
 inline double volumetric_strain_rate(const Mat<G::dim>& L, double radial_velocity, double radius) {
     double rate = L.trace();
-    if constexpr (G::axisymmetric) rate += radial_velocity / radius;
+    if constexpr (G::axisymmetric) rate += hoop_strain_rate(radial_velocity, radius);
     return rate;
 }
 
@@ -132,6 +146,40 @@ inline double nodal_viscosity(double volumetric_strain_rate, double density, dou
     if (!(volumetric_strain_rate < 0.0)) return 0.0;
     const double hr = smallest_h * volumetric_strain_rate;
     return density * (c_linear * sound_speed * (-hr) + c_quadratic * hr * hr);
+}
+
+// Spec section 11, step 7: a node's stable time step h / (c + sqrt(Q / rho) + w), with h its
+// smallest h_ij (its stable length), c its longitudinal sound speed, Q its viscous pressure (the
+// larger of the nodal and its largest bond viscosity; negative taken as 0) and w the closing speed
+// of a contact it takes part in (0 without one). The step is C_cfl times the smallest over nodes.
+inline double stable_time_step(double stable_length, double sound_speed, double viscous_pressure, double density,
+                               double closing_speed) {
+    return stable_length / (sound_speed + std::sqrt(std::max(viscous_pressure, 0.0) / density) + closing_speed);
+}
+
+// Spec section 11, steps 3 and 4, the leapfrog: v^{n+1/2} = v^{n-1/2} + dt_avg F^n / M, one
+// component, with dt_avg the mean of the two half steps around t^n ...
+inline double leapfrog_velocity(double velocity, double force, double mass, double dt_avg) {
+    return velocity + dt_avg * force / mass;
+}
+
+// ... and x^{n+1} = x^n + dt^{n+1/2} v^{n+1/2}.
+inline double leapfrog_position(double position, double velocity, double dt) { return position + dt * velocity; }
+
+// Eq. 67: the velocity change velocity smoothing makes at a centre, dv_i = C (vbar_i - v_i), one
+// component, with vbar_i = sum_j R_ij v_j / sum_j R_ij (Eq. 66) given as its two sums.
+inline double smoothing_change(double coefficient, double weighted_velocity, double weight_sum, double velocity) {
+    return coefficient * (weighted_velocity / weight_sum - velocity);
+}
+
+// Eq. 69-72: neighbour j of a smoothed centre i receives - M_i R_ij dv_i / sum_k R_ik M_k, so that
+// momentum is kept; this is the factor M_i / sum_k R_ik M_k that multiplies - R_ij dv_i.
+inline double smoothing_share(double mass, double weighted_mass) { return mass / weighted_mass; }
+
+// Eq. 73: the kinetic energy smoothing takes from a node, dE_i = M_i (|v_i|^2 - |v_i + dV_i|^2) / 2,
+// from the squared speeds before and after; it becomes the node's internal energy.
+inline double smoothing_heat(double mass, double speed_squared_before, double speed_squared_after) {
+    return 0.5 * mass * (speed_squared_before - speed_squared_after);
 }
 
 // Eq. 13: eps_v(t + dt) = eps_v(t) + eps_v_dot dt (1 + eps_v(t)), integrated in the initial
