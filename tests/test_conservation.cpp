@@ -237,9 +237,9 @@ TEST_P(Conservation, WithBondViscosityTheDifferenceIsTheBondTerm) {
 // velocity field w other than the one the gradient saw, adds up to the power of the engine's
 // forces at w, and its viscous part is Q_i V_i tr L_i(w) (+ Q_i V_i w_x / x_i).
 template <class G>
-void check_stress_power(const ForceCase& s) {
+void check_stress_power(const ForceCase& s, bool full_normalisation = false) {
     constexpr int D = G::dim;
-    auto e = evaluate<G>(s, nullptr);
+    auto e = evaluate<G>(s, nullptr, full_normalisation);
     auto& n = e.nodes;
     std::mt19937_64 rng(11);
     std::uniform_real_distribution<double> u(-100.0, 100.0);
@@ -252,6 +252,7 @@ void check_stress_power(const ForceCase& s) {
     }
     std::vector<double> power(n.size()), viscous(n.size());
     auto f = force_fields<D>(n, a);
+    f.full_normalisation = full_normalisation;
     compute_stress_power<G>(e.lists, s.weight, f, wp, n.size(), power.data(), viscous.data());
     double sum = 0.0, force_power = 0.0, scale = 0.0;
     for (std::size_t i = 0; i < n.size(); ++i) {
@@ -265,6 +266,7 @@ void check_stress_power(const ForceCase& s) {
     // The viscous part from the velocity gradient of w (the gradient kernel, not the power kernel).
     for (int c = 0; c < D; ++c) std::copy(w[c].begin(), w[c].end(), n.velocity[c].begin());
     auto g = gradient_fields<D>(n, a);
+    g.full_normalisation = full_normalisation;
     compute_velocity_gradient<G>(e.lists, s.weight, g);
     for (std::size_t i = 0; i < n.size(); ++i) {
         double trace = 0.0;
@@ -279,6 +281,14 @@ void check_stress_power(const ForceCase& s) {
 TEST_P(Conservation, StressPowerAtOtherVelocitiesIsTheForcePowerThere) {
     const ForceCase s = GetParam();
     dispatch_geometry(s.geometry, [&](auto g) { check_stress_power<decltype(g)>(s); });
+}
+
+TEST_P(Conservation, StressPowerAtOtherVelocitiesWithTheMomentMatrixNormalisation) {
+    // The stress power contracts the row's moment of velocity differences with sigma_i N_i
+    // (kernels.hpp, accumulate_velocity_moment); with the full normalisation N_i has off-diagonal
+    // terms and sigma_i N_i is not symmetric, so a transposed contraction would show here.
+    const ForceCase s = GetParam();
+    dispatch_geometry(s.geometry, [&](auto g) { check_stress_power<decltype(g)>(s, true); });
 }
 
 INSTANTIATE_TEST_SUITE_P(AllGeometries, Conservation, ::testing::ValuesIn(setups()),

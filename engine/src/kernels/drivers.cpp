@@ -254,15 +254,17 @@ void stress_power_impl(const CompressedRows& lists, const ForceFields<G::dim>& f
             const double q = f.viscous_pressure ? f.viscous_pressure[i] : 0.0;
             const double volume = f.volume[i];
             const Vec<D> v_i = load<D>(velocity, i);
-            double sum = 0.0, divergence = 0.0;
+            // The row's moment of velocity differences B_i (kernels.hpp, accumulate_velocity_moment):
+            // power -V_i (sigma_i N_i) : B_i, divergence N_i : B_i, no pair force made.
+            Mat<D> moment = Mat<D>::Zero();
             for (NodeIndex j : lists.row(i)) {
                 const auto p = f.pairs.template pair<W>(i, j);
-                const Vec<D> normalised_l = normalisation * p.l;
                 Vec<D> dv = load<D>(velocity, j) - v_i;
                 if (f.pairs.sliding(i, j)) dv = along_pair<D>(f.pairs.sliding_normal(i, j, p.l), dv);  // spec section 2
-                sum += pair_force(p, volume, f.size_weight[j], normalised_l, sigma, 0.0).dot(dv);  // Eq. 21-22
-                divergence += p.R * f.size_weight[j] * p.inv_r * normalised_l.dot(dv);
+                accumulate_velocity_moment<D>(p, f.size_weight[j], dv, moment);
             }
+            double sum = -volume * (sigma * normalisation).cwiseProduct(moment).sum();  // Eq. 21-22 summed over j
+            double divergence = normalisation.cwiseProduct(moment).sum();
             if constexpr (G::axisymmetric) {
                 const double hoop = hoop_force(out_of_plane_stress(f.deviatoric_stress, f.pressure, f.viscous_pressure, i), volume,
                                                f.pairs.position[0][i]);
