@@ -74,14 +74,11 @@ struct ReturnResult {
     int iterations = 0;  // Johnson-Cook: flow-stress evaluations of the return's iteration (0 otherwise)
 };
 
-// Radial return of the trial deviator to the flow stress of `strength` at plastic strain
-// eps_p, strain rate (1/s) and homologous temperature; shear modulus G (Pa).
-// dt: the step's length; the Johnson-Cook rate term uses the equivalent plastic strain rate
-// d eps_p / dt of the return itself (Johnson and Cook 1983 define epsdot* so).
-ReturnResult radial_return(const Strength& strength, const Eigen::Matrix3d& trial, double shear_modulus,
-                           double plastic_strain, double dt, double homologous_temperature);
-
-// The same return for one strength model, chosen by overload (a PointModel picks it once per material).
+// Radial return of the trial deviator to the flow stress of the strength model at plastic strain
+// eps_p, strain rate (1/s) and homologous temperature; shear modulus G (Pa). dt: the step's length;
+// the Johnson-Cook rate term uses the equivalent plastic strain rate d eps_p / dt of the return
+// itself (Johnson and Cook 1983 define epsdot* so). One overload per model (a PointModel picks it
+// once per material).
 ReturnResult model_return(const ElasticStrength& strength, const Eigen::Matrix3d& trial, double shear_modulus,
                           double plastic_strain, double dt, double homologous_temperature);
 ReturnResult model_return(const VonMisesStrength& strength, const Eigen::Matrix3d& trial, double shear_modulus,

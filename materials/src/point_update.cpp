@@ -116,11 +116,6 @@ PointResult update_with(const PointModel& model, PointState& state, const PointI
         trial -= (trial.trace() / 3.0) * identity;
         const detail::ReturnResult r =
             detail::model_return(strength, trial, m.shear_modulus, state.plastic_strain, inc.dt, t_star);
-        if (r.iterations > johnson_cook_max_iterations) {
-            PointResult not_converged = fault(PointFault::return_not_converged);
-            not_converged.return_iterations = r.iterations;
-            return not_converged;
-        }
         s_new = r.deviator;
         return_iterations = r.iterations;
         plastic_increment = r.plastic_strain_increment;
@@ -165,6 +160,13 @@ PointResult update_with(const PointModel& model, PointState& state, const PointI
             pressure = 0.0;
             energy = known;
         }
+    }
+    // A Johnson-Cook return that did not converge is reported after the faults of the equation of
+    // state and the energy solve, as the engine reported them before these were PointFaults.
+    if (return_iterations > johnson_cook_max_iterations) {
+        PointResult not_converged = fault(PointFault::return_not_converged);
+        not_converged.return_iterations = return_iterations;
+        return not_converged;
     }
 
     // 5-6. Plastic work and temperature.

@@ -3,8 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <type_traits>
-#include <variant>
 
 #include "internal.hpp"
 
@@ -92,8 +90,8 @@ ReturnResult project(const Eigen::Matrix3d& trial, double trial_equivalent, doub
 // (the rate term's C ln(x / dt), and eps_p^n with n < 1) and Newton's steps undershoot, so the
 // iteration mostly halves (tests/materials/test_strength.cpp, RadialReturn.JohnsonCookIterationBound,
 // asserts the 52 of bisection). The loop is capped at johnson_cook_max_iterations (material.hpp);
-// a return that reaches the cap is reported as not converged (PointResult::return_iterations) and
-// stops the run, never used silently.
+// a return that reaches the cap is a fault of the point update (PointFault::return_not_converged),
+// which stops the run: it is never used silently.
 ReturnResult johnson_cook_return(const JohnsonCookStrength& jc, const Eigen::Matrix3d& trial, double trial_equivalent,
                                  double shear_modulus, double plastic_strain, double dt, double t_star,
                                  double initial_flow_stress) {
@@ -146,7 +144,7 @@ ReturnResult johnson_cook_return(const JohnsonCookStrength& jc, const Eigen::Mat
 // along itself onto the yield surface; the plastic strain increment satisfies
 // sigma_eq* - 3 G d eps_p = Y(eps_p + d eps_p). Y = 0 at and above melt for both plastic models
 // (materials.md). With G = 0 no elastic strain exists to turn plastic: the deviator is only
-// scaled back and d eps_p = 0. One overload per strength model; radial_return visits them.
+// scaled back and d eps_p = 0. One overload per strength model.
 
 // An elastic material: no return.
 ReturnResult model_return(const ElasticStrength&, const Eigen::Matrix3d& trial, double, double, double, double) {
@@ -193,13 +191,6 @@ ReturnResult model_return(const JohnsonCookStrength& jc, const Eigen::Matrix3d& 
         return project(trial, trial_equivalent, y0, 0.0);
     }
     return johnson_cook_return(jc, trial, trial_equivalent, shear_modulus, plastic_strain, dt, t_star, y0);
-}
-
-ReturnResult radial_return(const Strength& strength, const Eigen::Matrix3d& trial, double shear_modulus,
-                           double plastic_strain, double dt, double homologous_temperature) {
-    return std::visit(
-        [&](const auto& model) { return model_return(model, trial, shear_modulus, plastic_strain, dt, homologous_temperature); },
-        strength);
 }
 
 }  // namespace detail

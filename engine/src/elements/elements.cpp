@@ -457,7 +457,7 @@ void ElementPart::move(double dt) {
         for (int c = 0; c < 2; ++c) {
             double* x = n.position[c].data();
             const double* v = n.velocity[c].data();
-            for (std::size_t i = r.begin(); i != r.end(); ++i) x[i] += dt * v[i];
+            for (std::size_t i = r.begin(); i != r.end(); ++i) x[i] = leapfrog_position(x[i], v[i], dt);
         }
     });
 }
@@ -697,7 +697,7 @@ void ElementPart::integrate(double dt_avg, double dt_next) {
             for (std::size_t i = r.begin(); i != r.end(); ++i) {
                 const double mass = n.mass[i];
                 std::array<double, 2> v_old{n.velocity[0][i], n.velocity[1][i]};
-                std::array<double, 2> v{v_old[0] + dt_avg * n.force[0][i] / mass, v_old[1] + dt_avg * n.force[1][i] / mass};
+                std::array<double, 2> v{leapfrog_velocity(v_old[0], n.force[0][i], mass, dt_avg), leapfrog_velocity(v_old[1], n.force[1][i], mass, dt_avg)};
                 // The axis: x stays 0 (the radial force on an axis node does no work, since u = 0).
                 if (n.on_axis[i]) v[0] = 0.0;
                 n.contact[i] = 0;

@@ -254,17 +254,17 @@ void stress_power_impl(const CompressedRows& lists, const ForceFields<G::dim>& f
             const double q = f.viscous_pressure ? f.viscous_pressure[i] : 0.0;
             const double volume = f.volume[i];
             const Vec<D> v_i = load<D>(velocity, i);
-            // The row's moment of velocity differences B_i (kernels.hpp, accumulate_velocity_moment):
+            // The row's sum of velocity differences B_i (kernels.hpp, accumulate_velocity_difference):
             // power -V_i (sigma_i N_i) : B_i, divergence N_i : B_i, no pair force made.
-            Mat<D> moment = Mat<D>::Zero();
+            Mat<D> difference = Mat<D>::Zero();
             for (NodeIndex j : lists.row(i)) {
                 const auto p = f.pairs.template pair<W>(i, j);
                 Vec<D> dv = load<D>(velocity, j) - v_i;
                 if (f.pairs.sliding(i, j)) dv = along_pair<D>(f.pairs.sliding_normal(i, j, p.l), dv);  // spec section 2
-                accumulate_velocity_moment<D>(p, f.size_weight[j], dv, moment);
+                accumulate_velocity_difference<D>(p, f.size_weight[j], dv, difference);
             }
-            double sum = -volume * (sigma * normalisation).cwiseProduct(moment).sum();  // Eq. 21-22 summed over j
-            double divergence = normalisation.cwiseProduct(moment).sum();
+            double sum = -volume * (sigma * normalisation).cwiseProduct(difference).sum();  // Eq. 21-22 summed over j
+            double divergence = normalisation.cwiseProduct(difference).sum();
             if constexpr (G::axisymmetric) {
                 const double hoop = hoop_force(out_of_plane_stress(f.deviatoric_stress, f.pressure, f.viscous_pressure, i), volume,
                                                f.pairs.position[0][i]);

@@ -15,19 +15,19 @@ constexpr std::size_t reduce_grain = 4096;  // fixed, so that every sum has one 
 }  // namespace
 
 void RigidPlanes::assign(std::vector<std::size_t> rigid) {
-    index_ = std::move(rigid);
-    reaction_.assign(index_.size(), 0.0);
-    impulse_.assign(index_.size(), 0.0);
+    ghost_plane_ = std::move(rigid);
+    reaction_.assign(ghost_plane_.size(), 0.0);
+    impulse_.assign(ghost_plane_.size(), 0.0);
 }
 
 const GhostPlane* RigidPlanes::first(const GhostSet& ghosts) const {
-    return index_.empty() ? nullptr : &ghosts.planes()[index_.front()];
+    return ghost_plane_.empty() ? nullptr : &ghosts.planes()[ghost_plane_.front()];
 }
 
 void RigidPlanes::take_reactions(const GhostSet& ghosts, const NodeStore& nodes, std::size_t real) {
     if (ghosts.empty()) return;
     const auto all = ghosts.normal_reactions(nodes, real);
-    for (std::size_t k = 0; k < index_.size(); ++k) reaction_[k] = all[index_[k]];
+    for (std::size_t k = 0; k < ghost_plane_.size(); ++k) reaction_[k] = all[ghost_plane_[k]];
 }
 
 void RigidPlanes::add_impulses(double dt_avg) {
@@ -37,7 +37,7 @@ void RigidPlanes::add_impulses(double dt_avg) {
 void RigidPlanes::guard_penetration(const GhostSet& ghosts, NodeStore& nodes, std::size_t real, EnergyLedger& ledger) {
     for (std::size_t p = 0; p < ghosts.planes().size(); ++p) {
         const auto& plane = ghosts.planes()[p];
-        const auto rigid = std::find(index_.begin(), index_.end(), p);
+        const auto rigid = std::find(ghost_plane_.begin(), ghost_plane_.end(), p);
         using WorkAndImpulse = std::array<double, 2>;
         const WorkAndImpulse lost = tbb::parallel_deterministic_reduce(
             tbb::blocked_range<std::size_t>(0, real, reduce_grain), WorkAndImpulse{0.0, 0.0},
@@ -57,17 +57,17 @@ void RigidPlanes::guard_penetration(const GhostSet& ghosts, NodeStore& nodes, st
             },
             [](WorkAndImpulse x, const WorkAndImpulse& y) { return WorkAndImpulse{x[0] + y[0], x[1] + y[1]}; });
         ledger.add_boundary_work(lost[0]);
-        if (rigid != index_.end()) impulse_[static_cast<std::size_t>(rigid - index_.begin())] += lost[1];
+        if (rigid != ghost_plane_.end()) impulse_[static_cast<std::size_t>(rigid - ghost_plane_.begin())] += lost[1];
     }
 }
 
 void RigidPlanes::report(const GhostSet& ghosts, const std::vector<double>* element_reactions,
                          const std::vector<double>* element_impulses, std::vector<PlaneReport>& out) const {
     out.clear();
-    for (std::size_t k = 0; k < index_.size(); ++k) {
+    for (std::size_t k = 0; k < ghost_plane_.size(); ++k) {
         const double element_reaction = element_reactions ? (*element_reactions)[k] : 0.0;
         const double element_impulse = element_impulses ? (*element_impulses)[k] : 0.0;
-        out.push_back({ghosts.planes()[index_[k]].name, reaction_[k] + element_reaction, impulse_[k] + element_impulse});
+        out.push_back({ghosts.planes()[ghost_plane_[k]].name, reaction_[k] + element_reaction, impulse_[k] + element_impulse});
     }
 }
 
@@ -79,7 +79,7 @@ void RigidPlanes::write_state(StateWriter& out) const {
 void RigidPlanes::read_state(StateReader& in) {
     in.array(impulse_);
     in.array(reaction_);
-    if (impulse_.size() != index_.size() || reaction_.size() != index_.size()) in.fail("its planes are not the scene's");
+    if (impulse_.size() != ghost_plane_.size() || reaction_.size() != ghost_plane_.size()) in.fail("its planes are not the scene's");
 }
 
 }  // namespace gpa

@@ -3,8 +3,8 @@
 // ghost plane each rigid plane of the scene is, the normal force each plane exerted on the particle
 // bodies in the last force pass, and the impulse each has given them since t = 0 (the force over
 // every velocity update and the momentum the penetration guard took away). Also the penetration
-// guard itself, for every plane with ghosts. Saves and restores its reactions and impulses as its
-// own checkpoint section.
+// guard itself, for every plane with ghosts. Saves and restores its reactions and impulses itself,
+// as part of the checkpoint's TIME section (no tag of its own).
 
 #include <cstddef>
 #include <vector>
@@ -22,7 +22,7 @@ public:
     // Set-up: `rigid` lists the ghost-plane index of each rigid plane of the scene, in scene order.
     void assign(std::vector<std::size_t> rigid);
 
-    std::size_t size() const { return index_.size(); }
+    std::size_t size() const { return ghost_plane_.size(); }
     // The first rigid plane (the one a Taylor bar stands on, measure.hpp), or null without one.
     const GhostPlane* first(const GhostSet& ghosts) const;
 
@@ -48,7 +48,7 @@ public:
     void read_state(StateReader& in);
 
 private:
-    std::vector<std::size_t> index_;  // ghost-plane index of each rigid plane
+    std::vector<std::size_t> ghost_plane_;  // ghost-plane index of each rigid plane
     std::vector<double> reaction_;    // N, the last force pass's
     std::vector<double> impulse_;     // N s, since t = 0
 };

@@ -48,8 +48,8 @@ void compute_forces(const CompressedRows& lists, const ScatterPlan& plan, Weight
 // sides of a velocity update, sum_i power_i dt is the kinetic energy the stress forces add in that
 // update, to round-off, so booking -power_i dt as internal energy of i conserves energy exactly.
 // `velocity` covers ghosts too (mirrored like the velocities themselves). No pair force is made:
-// the pairs are gathered into the row's moment of velocity differences and contracted with
-// sigma_i N_i once per centre (kernels.hpp, accumulate_velocity_moment).
+// the pairs are gathered into the row's sum of velocity differences and contracted with
+// sigma_i N_i once per centre (kernels.hpp, accumulate_velocity_difference).
 // With `hourglass` set (its power_velocity the same velocities, no force), the same pass also
 // writes each centre's hourglass-control powers (hourglass.hpp, hourglass_centre) to
 // hourglass->power and hourglass->stiffness_power, while the centre's row is in cache: one visit

@@ -113,12 +113,14 @@ inline Vec<D> pair_force(const PairGeometry<D>& p, double volume_i, double size_
 // Spec section 5, "[spec] Compatible energy": the work rate of centre i's stress forces at some
 // velocities v, sum_j P(ij) . (v_j - v_i), gathered without making a single pair force. With P(ij) of
 // Eq. 21-22 (no bond viscosity), P(ij) . dv = -V_i (R W_j / r) dv^T sigma_i N_i l, so the sum is
-// -V_i (sigma_i N_i) : B_i with B_i = sum_j (R W_j / r) dv_j l_j^T, the row's moment of velocity
-// differences (D x D; the velocity gradient of Eq. 7-11 before its normalisation, at v); the nodal
-// viscosity's part -Q_i I of sigma_i gives Q_i V_i N_i : B_i. One pair's share of B_i:
+// -V_i (sigma_i N_i) : B_i with B_i = sum_j (R W_j / r) dv_j l_j^T, the row's sum of velocity
+// differences (D x D; GradientSums::difference, the velocity gradient of Eq. 7-11 before its
+// normalisation, here at v); the nodal viscosity's part -Q_i I of sigma_i gives Q_i V_i N_i : B_i.
+// One pair's share of B_i:
 template <int D>
-inline void accumulate_velocity_moment(const PairGeometry<D>& p, double size_weight_j, const Vec<D>& dv, Mat<D>& moment) {
-    moment.noalias() += (p.R * size_weight_j * p.inv_r) * dv * p.l.transpose();
+inline void accumulate_velocity_difference(const PairGeometry<D>& p, double size_weight_j, const Vec<D>& dv,
+                                           Mat<D>& difference) {
+    difference.noalias() += (p.R * size_weight_j * p.inv_r) * dv * p.l.transpose();
 }
 
 // Spec section 2, "[spec] Sliding contact": a pair across a contact or a crack (a closed separable

@@ -193,10 +193,12 @@ PointResult update_point(const Material& m, PointState& state, const PointIncrem
 // up when the PointModel is made, not at every point, and the constants every point needs (the
 // reference bulk modulus of the sound-speed floor) are worked out then. The engine makes one per
 // material group and stress update; the points of the group then run code compiled for their models,
-// with no branch on the model and no exception. Refers to the material, which must outlive it.
+// with no branch on the model and no exception. Refers to the material, which must outlive it and
+// must not change while it is in use (make a new PointModel after changing a material's models).
 class PointModel {
 public:
     explicit PointModel(const Material& material);
+    PointModel(Material&&) = delete;  // a temporary would not outlive it
 
     // The point update of update_point, without exceptions: a point that cannot be advanced comes
     // back with PointResult::fault set and its state unchanged.
