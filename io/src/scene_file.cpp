@@ -298,8 +298,9 @@ PlaneSpec read_plane(const Reporter& reporter, const toml::table& table, std::si
     p.position = r.required_quantity("position", D::Length);
 
     if (const toml::node* side = r.find("side")) {
-        if (side->is_string()) {
-            p.side = *r.choice<int>("side", {{"above", +1}, {"below", -1}});
+        const auto* word = side->as_string();
+        if (word && (word->get() == "above" || word->get() == "below")) {
+            p.side = word->get() == "above" ? +1 : -1;
         } else if (const auto* number = side->as_integer(); number && (number->get() == 1 || number->get() == -1)) {
             p.side = static_cast<int>(number->get());
         } else {

@@ -58,6 +58,43 @@ std::string message_after(const std::function<void(Scene&)>& change) {
 
 TEST(ValidateScene, TaylorSceneBuiltInCodePasses) { EXPECT_NO_THROW(validate_scene(taylor_scene())); }
 
+TEST(ValidateScene, BodiesMayTouchButNotOverlap) {
+    // A second bar stacked on the first: touching end to end passes; moved down by one lattice
+    // spacing, its lowest row of nodes (cell centres half a spacing above its base) lies inside the
+    // first bar and the scene is refused, naming both bars and the 15 nodes of that row (3.81 mm
+    // radius at 0.254 mm: 15 cells across the radius).
+    const auto stacked = [](double gap) {
+        return [gap](Scene& s) {
+            BodySpec top = s.bodies[0];
+            top.name = "top";
+            top.origin[1] = top.length + gap;
+            s.bodies.push_back(top);
+        };
+    };
+    EXPECT_EQ(message_after(stacked(0.0)), "");
+    EXPECT_EQ(message_after(stacked(1e-3)), "");
+    EXPECT_EQ(message_after(stacked(-0.254e-3)),
+              "body \"bar\" (body[0]) overlaps body \"top\" (body[1]): 15 of its nodes lie inside it, the first at "
+              "(x, z) = (0.127, 25.273) mm; bodies may touch but not overlap (move one, or make it smaller)");
+    // A hollow sphere's core is not inside it: a short bar in the cavity passes (its corners are
+    // 4.47 mm from the centre, the cavity's radius is 5 mm).
+    EXPECT_EQ(message_after([](Scene& s) {
+                  BodySpec shell;
+                  shell.name = "shell";
+                  shell.shape = ShapeKind::Sphere;
+                  shell.origin = {0.0, 0.0127, 0.0};
+                  shell.radius = 0.008;
+                  shell.inner_radius = 0.005;
+                  shell.spacing = 0.000254;
+                  shell.material = "OFHC copper";
+                  s.bodies[0].radius = 0.002;
+                  s.bodies[0].origin[1] = 0.0087;
+                  s.bodies[0].length = 0.008;
+                  s.bodies.push_back(shell);
+              }),
+              "");
+}
+
 TEST(ValidateScene, BodiesAndMaterials) {
     EXPECT_MESSAGE_HAS([](Scene& s) { s.bodies.clear(); }, "at least one body");
     EXPECT_MESSAGE_HAS([](Scene& s) { s.bodies[0].material = "brass"; }, "body \"bar\" (body[0]).material: \"brass\"");
