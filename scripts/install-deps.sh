@@ -10,6 +10,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev libtomlplusplus-dev nlohmann-json3-dev
   libpng-dev   # gpa render: PNG pictures of snapshots
+  libudunits2-dev   # tests only: the unit reader checked against UDUNITS-2's database
   clang libclang-rt-14-dev llvm   # scripts/sanitize.sh: sanitizers, libFuzzer, llvm-symbolizer
 )
 if [[ "${1:-}" == "--with-peers" ]]; then

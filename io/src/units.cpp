@@ -21,6 +21,11 @@ constexpr std::array dimensions{
 
 using D = Dimension;
 
+// The pound-force per square inch in Pa: 1 lbf = 4.4482216152605 N (0.45359237 kg times standard
+// gravity 9.80665 m/s^2, both exact by definition), over (0.0254 m)^2.
+constexpr double pound_force = 4.4482216152605;
+constexpr double psi = pound_force / (0.0254 * 0.0254);
+
 // The preferred spelling of each unit comes first within its dimension; aliases follow.
 constexpr std::array units{
     Unit{"%", D::Dimensionless, -2},
@@ -30,6 +35,7 @@ constexpr std::array units{
     Unit{"mm", D::Length, -3},
     Unit{"um", D::Length, -6},
     Unit{"in", D::Length, 0, 0.0254},
+    Unit{"ft", D::Length, 0, 0.3048},
 
     Unit{"s", D::Time, 0},
     Unit{"ms", D::Time, -3},
@@ -43,6 +49,8 @@ constexpr std::array units{
     Unit{"mm/us", D::Velocity, 3},
     Unit{"cm/us", D::Velocity, 4},
     Unit{"cm/s", D::Velocity, -2},
+    Unit{"mm/ms", D::Velocity, 0},
+    Unit{"ft/s", D::Velocity, 0, 0.3048},
 
     Unit{"kg/m^3", D::Density, 0},
     Unit{"g/cc", D::Density, 3},
@@ -57,6 +65,10 @@ constexpr std::array units{
     Unit{"bar", D::Pressure, 5},
     Unit{"kbar", D::Pressure, 8},
     Unit{"Mbar", D::Pressure, 11},
+    Unit{"N/mm^2", D::Pressure, 6},
+    Unit{"GN/m^2", D::Pressure, 9},
+    Unit{"psi", D::Pressure, 0, psi},
+    Unit{"ksi", D::Pressure, 3, psi},
 
     Unit{"K", D::Temperature, 0},
 
@@ -78,35 +90,254 @@ constexpr std::array units{
     Unit{"s^-1", D::StrainRate, 0, 1.0, true},
 };
 
-// The form units are compared in: no white space; '*' and the middle dot become '.'; the micro
-// sign and the Greek mu become 'u'; superscript three becomes "^3".
+// The form units are compared in: '*' and the middle dot become '.', and so does white space
+// between two names ("kg K", "m s^-1": a product); other white space goes ("kg / m^3"); the micro
+// sign and the Greek mu become 'u'; superscripts two and three become "^2" and "^3".
 std::string canonical(std::string_view unit) {
     std::string out;
+    bool space = false;  // white space since the last character kept
+    const auto separator = [](char c) { return c == '/' || c == '.' || c == '(' || c == ')' || c == '^'; };
     for (std::size_t i = 0; i < unit.size(); ++i) {
         const char c = unit[i];
-        if (c == ' ' || c == '\t') continue;
-        if (c == '*') {
-            out += '.';
+        if (c == ' ' || c == '\t') {
+            space = true;
             continue;
         }
         const auto next = [&](std::size_t k) { return i + k < unit.size() ? unit[i + k] : '\0'; };
-        if (c == '\xC2' && next(1) == '\xB7') {  // middle dot
-            out += '.';
+        std::string_view piece = unit.substr(i, 1);
+        if (c == '*') {
+            piece = ".";
+        } else if (c == '\xC2' && next(1) == '\xB7') {  // middle dot
+            piece = ".";
             ++i;
-        } else if (c == '\xC2' && next(1) == '\xB5') {  // micro sign
-            out += 'u';
-            ++i;
-        } else if (c == '\xCE' && next(1) == '\xBC') {  // Greek small mu
-            out += 'u';
+        } else if ((c == '\xC2' && next(1) == '\xB5') || (c == '\xCE' && next(1) == '\xBC')) {  // micro, mu
+            piece = "u";
             ++i;
         } else if (c == '\xC2' && next(1) == '\xB3') {  // superscript three
-            out += "^3";
+            piece = "^3";
             ++i;
-        } else {
-            out += c;
+        } else if (c == '\xC2' && next(1) == '\xB2') {  // superscript two
+            piece = "^2";
+            ++i;
         }
+        if (space && !out.empty() && !separator(out.back()) && !separator(piece.front())) out += '.';
+        space = false;
+        out += piece;
     }
     return out;
+}
+
+bool is_digit(char c) { return c >= '0' && c <= '9'; }
+
+// Compound units (mm/ms, GN/m^2, lbf/in^2, kg/(m s)...): products and quotients of the base units
+// below, each with an optional SI prefix where the base takes one and an optional integer power.
+// Everything after the first '/' is in the denominator ("J/kg.K" and "J/(kg K)" are J/(kg K), as
+// engineers write them; "J/kg/K" too). The dimension follows from the exponents of length, mass,
+// time and temperature; decimal prefixes and units join the number's exponent (no round-off of
+// their own, as for the listed units), the customary ones multiply once.
+struct Exponents {
+    int length = 0, mass = 0, time = 0, temperature = 0;
+    bool operator==(const Exponents&) const = default;
+};
+
+struct Base {
+    std::string_view symbol;
+    Exponents exponents;
+    int decimal_exponent = 0;
+    double factor = 1.0;
+    bool prefixed = false;  // takes an SI prefix (mm, kg, MPa, kbar)
+};
+
+constexpr Exponents length_e{1, 0, 0, 0}, mass_e{0, 1, 0, 0}, time_e{0, 0, 1, 0}, temperature_e{0, 0, 0, 1};
+constexpr Exponents pressure_e{-1, 1, -2, 0}, force_e{1, 1, -2, 0}, energy_e{2, 1, -2, 0};
+
+constexpr std::array bases{
+    Base{"m", length_e, 0, 1.0, true},
+    Base{"g", mass_e, -3, 1.0, true},
+    Base{"s", time_e, 0, 1.0, true},
+    Base{"K", temperature_e},
+    Base{"Pa", pressure_e, 0, 1.0, true},
+    Base{"N", force_e, 0, 1.0, true},
+    Base{"J", energy_e, 0, 1.0, true},
+    Base{"bar", pressure_e, 5, 1.0, true},
+    Base{"cc", {3, 0, 0, 0}, -6},
+    Base{"min", time_e, 0, 60.0},
+    Base{"h", time_e, 0, 3600.0},
+    Base{"in", length_e, 0, 0.0254},
+    Base{"ft", length_e, 0, 0.3048},
+    Base{"lb", mass_e, 0, 0.45359237},
+    Base{"lbf", force_e, 0, pound_force},
+    Base{"psi", pressure_e, 0, psi},
+    Base{"ksi", pressure_e, 3, psi},
+    // Words, for those who spell units out.
+    Base{"second", time_e},
+    Base{"seconds", time_e},
+    Base{"millisecond", time_e, -3},
+    Base{"milliseconds", time_e, -3},
+    Base{"microsecond", time_e, -6},
+    Base{"microseconds", time_e, -6},
+    Base{"nanosecond", time_e, -9},
+    Base{"nanoseconds", time_e, -9},
+    Base{"minute", time_e, 0, 60.0},
+    Base{"minutes", time_e, 0, 60.0},
+    Base{"hour", time_e, 0, 3600.0},
+    Base{"hours", time_e, 0, 3600.0},
+    Base{"metre", length_e},
+    Base{"metres", length_e},
+    Base{"meter", length_e},
+    Base{"meters", length_e},
+    Base{"millimetre", length_e, -3},
+    Base{"millimetres", length_e, -3},
+    Base{"millimeter", length_e, -3},
+    Base{"millimeters", length_e, -3},
+    Base{"inch", length_e, 0, 0.0254},
+    Base{"inches", length_e, 0, 0.0254},
+    Base{"foot", length_e, 0, 0.3048},
+    Base{"feet", length_e, 0, 0.3048},
+};
+
+struct Prefix {
+    char symbol;
+    int decimal_exponent;
+};
+constexpr std::array prefixes{Prefix{'n', -9}, Prefix{'u', -6}, Prefix{'m', -3}, Prefix{'c', -2},
+                              Prefix{'k', 3},  Prefix{'M', 6},  Prefix{'G', 9}};
+
+// What a unit string converts by: SI value = number * 10^decimal_exponent * factor.
+struct Conversion {
+    Exponents exponents;
+    int decimal_exponent = 0;
+    double factor = 1.0;
+};
+
+constexpr Exponents exponents_of(Dimension d) {
+    switch (d) {
+        case D::Dimensionless: return {};
+        case D::Length: return length_e;
+        case D::Time: return time_e;
+        case D::Velocity: return {1, 0, -1, 0};
+        case D::Density: return {-3, 1, 0, 0};
+        case D::Pressure: return pressure_e;
+        case D::Temperature: return temperature_e;
+        case D::SpecificHeat: return {2, 0, -2, -1};
+        case D::SpecificEnergy: return {2, 0, -2, 0};
+        case D::StrainRate: return {0, 0, -1, 0};
+    }
+    return {};
+}
+
+std::optional<Dimension> dimension_of(const Exponents& e) {
+    for (const Dimension d : dimensions) {
+        if (exponents_of(d) == e) return d;
+    }
+    return std::nullopt;
+}
+
+std::string describe(const Exponents& e) {
+    std::string out;
+    const auto part = [&](std::string_view symbol, int power) {
+        if (power == 0) return;
+        if (!out.empty()) out += ' ';
+        out += symbol;
+        if (power != 1) out += fmt::format("^{}", power);
+    };
+    part("m", e.length);
+    part("kg", e.mass);
+    part("s", e.time);
+    part("K", e.temperature);
+    return out.empty() ? std::string("1") : out;
+}
+
+std::optional<Conversion> base_unit(std::string_view word) {
+    for (const Base& b : bases) {
+        if (b.symbol == word) return Conversion{b.exponents, b.decimal_exponent, b.factor};
+    }
+    if (word.size() < 2) return std::nullopt;
+    for (const Prefix& p : prefixes) {
+        if (word.front() != p.symbol) continue;
+        for (const Base& b : bases) {
+            if (b.prefixed && b.symbol == word.substr(1)) {
+                return Conversion{b.exponents, b.decimal_exponent + p.decimal_exponent, b.factor};
+            }
+        }
+    }
+    return std::nullopt;
+}
+
+// One factor of a compound unit: a base unit with an optional power ("mm^3", "m3", "s^-1").
+std::optional<Conversion> unit_factor(std::string_view term) {
+    std::string_view word = term;
+    int power = 1;
+    const auto read_power = [&](std::string_view digits) {
+        int value = 0;
+        const auto [end, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), value);
+        return ec == std::errc{} && end == digits.data() + digits.size() && value != 0 && value >= -9 && value <= 9
+                   ? std::optional<int>(value)
+                   : std::nullopt;
+    };
+    if (const auto caret = term.find('^'); caret != std::string_view::npos) {
+        const auto p = read_power(term.substr(caret + 1));
+        if (!p) return std::nullopt;
+        word = term.substr(0, caret);
+        power = *p;
+    } else {
+        std::size_t k = term.size();
+        while (k > 0 && is_digit(term[k - 1])) --k;
+        if (k > 0 && k < term.size()) {
+            const auto p = read_power(term.substr(k));
+            if (!p) return std::nullopt;
+            word = term.substr(0, k);
+            power = *p;
+        }
+    }
+    auto c = base_unit(word);
+    if (!c) return std::nullopt;
+    Conversion out;
+    out.exponents = {c->exponents.length * power, c->exponents.mass * power, c->exponents.time * power,
+                     c->exponents.temperature * power};
+    out.decimal_exponent = c->decimal_exponent * power;
+    for (int k = 0; k < std::abs(power); ++k) out.factor = power > 0 ? out.factor * c->factor : out.factor / c->factor;
+    return out;
+}
+
+std::optional<Conversion> compound_unit(std::string_view written) {
+    std::string text = canonical(written);
+    // Parentheses only around the whole denominator: "J/(kg K)".
+    if (const auto open = text.find('('); open != std::string::npos) {
+        if (open == 0 || text[open - 1] != '/' || text.back() != ')' || text.find('(', open + 1) != std::string::npos ||
+            text.find(')') != text.size() - 1) {
+            return std::nullopt;
+        }
+        text = text.substr(0, open) + text.substr(open + 1, text.size() - open - 2);
+    } else if (text.find(')') != std::string::npos) {
+        return std::nullopt;
+    }
+    Conversion total;
+    double divisor = 1.0;  // the denominator's customary factors, divided once at the end
+    bool denominator = false;
+    std::size_t start = 0;
+    for (std::size_t k = 0; k <= text.size(); ++k) {
+        if (k < text.size() && text[k] != '/' && text[k] != '.') continue;
+        const std::string_view term = std::string_view(text).substr(start, k - start);
+        if (term.empty()) return std::nullopt;
+        if (term == "1" && start == 0 && k < text.size() && text[k] == '/') {
+            // "1/s": a numerator of one
+        } else {
+            const auto f = unit_factor(term);
+            if (!f) return std::nullopt;
+            const int sign = denominator ? -1 : 1;
+            total.exponents.length += sign * f->exponents.length;
+            total.exponents.mass += sign * f->exponents.mass;
+            total.exponents.time += sign * f->exponents.time;
+            total.exponents.temperature += sign * f->exponents.temperature;
+            total.decimal_exponent += sign * f->decimal_exponent;
+            (denominator ? divisor : total.factor) *= f->factor;
+        }
+        if (k < text.size() && text[k] == '/') denominator = true;
+        start = k + 1;
+    }
+    if (divisor != 1.0) total.factor /= divisor;
+    return total;
 }
 
 const Unit* find_unit(std::string_view written) {
@@ -142,8 +373,6 @@ struct WrittenNumber {
     long exponent = 0;
     std::size_t length = 0;   // characters of the text taken by the number
 };
-
-bool is_digit(char c) { return c >= '0' && c <= '9'; }
 
 std::optional<WrittenNumber> scan_number(std::string_view text) {
     WrittenNumber n;
@@ -190,6 +419,10 @@ std::string_view trim(std::string_view s) {
     return s;
 }
 
+constexpr std::string_view compound_hint =
+    ", or a compound of m, g, s, K, Pa, N, J, bar (with the prefixes n, u, m, c, k, M, G), cc, min, h, in, ft, "
+    "lb, lbf, psi, ksi and powers (\"mm/ms\", \"GN/m^2\", \"lbf/in^2\")";
+
 std::string article_name(Dimension d) {
     if (d == Dimension::Dimensionless) return "a plain number";
     return fmt::format("a {}", name_of(d));
@@ -197,7 +430,9 @@ std::string article_name(Dimension d) {
 
 std::string takes(Dimension d) {
     if (d == Dimension::Dimensionless) return "a plain number takes no unit (or %)";
-    return fmt::format("{} takes {}", article_name(d), accepted_units(d));
+    std::string out = fmt::format("{} takes {}, or a plain number in {}", article_name(d), accepted_units(d), si_unit_of(d));
+    if (d != Dimension::Temperature) out += compound_hint;
+    return out;
 }
 
 struct Split {
@@ -214,7 +449,7 @@ Split split(std::string_view text) {
     return {*number, trim(t.substr(number->length))};
 }
 
-double to_double(const WrittenNumber& n, const Unit* unit, std::string_view text) {
+double to_double(const WrittenNumber& n, const Conversion* unit, std::string_view text) {
     const long exponent = n.exponent + (unit ? unit->decimal_exponent : 0);
     const std::string composed = fmt::format("{}e{}", n.significand, exponent);
     double value = 0.0;
@@ -279,6 +514,18 @@ std::string accepted_units(Dimension d) {
     return list;
 }
 
+namespace {
+
+Conversion conversion_of(const Unit& u) { return {exponents_of(u.dimension), u.decimal_exponent, u.factor}; }
+
+// A listed unit, else a compound one; nullopt when neither reads the text.
+std::optional<Conversion> read_unit(std::string_view written) {
+    if (const Unit* listed = find_unit(written)) return conversion_of(*listed);
+    return compound_unit(written);
+}
+
+}  // namespace
+
 double parse_quantity(std::string_view text, Dimension expected) {
     const Split s = split(text);
     if (s.unit.empty()) {
@@ -286,7 +533,7 @@ double parse_quantity(std::string_view text, Dimension expected) {
         throw UnitError(fmt::format("\"{}\" has no unit: write {} as a plain number in {} or as a string with one of {}",
                                     text, article_name(expected), si_unit_of(expected), accepted_units(expected)));
     }
-    const Unit* unit = find_unit(s.unit);
+    const auto unit = read_unit(s.unit);
     if (!unit) {
         if (const Unit* near = case_insensitive_match(s.unit, expected)) {
             throw UnitError(fmt::format("unknown unit \"{}\" in \"{}\" (units are case-sensitive: did you mean \"{}\"?)",
@@ -294,27 +541,42 @@ double parse_quantity(std::string_view text, Dimension expected) {
         }
         throw UnitError(fmt::format("unknown unit \"{}\" in \"{}\"; {}", s.unit, text, takes(expected)));
     }
-    if (unit->dimension != expected) {
-        throw UnitError(fmt::format("\"{}\" is {}, not {}; {}", text, article_name(unit->dimension),
+    const auto dimension = dimension_of(unit->exponents);
+    if (!dimension) {
+        throw UnitError(fmt::format("\"{}\" is in {} (SI {}), which no scene value is; {}", text, s.unit,
+                                    describe(unit->exponents), takes(expected)));
+    }
+    if (*dimension != expected) {
+        throw UnitError(fmt::format("\"{}\" is {}, not {}; {}", text, article_name(*dimension),
                                     article_name(expected), takes(expected)));
     }
-    return to_double(s.number, unit, text);
+    return to_double(s.number, &*unit, text);
 }
 
 Quantity parse_any_quantity(std::string_view text) {
     const Split s = split(text);
     if (s.unit.empty()) return {to_double(s.number, nullptr, text), Dimension::Dimensionless};
-    const Unit* unit = find_unit(s.unit);
-    if (!unit) {
+    const auto unit = read_unit(s.unit);
+    const auto dimension = unit ? dimension_of(unit->exponents) : std::nullopt;
+    if (!dimension) {
         std::string all;
         for (const Dimension d : dimensions) {
             if (d == Dimension::Dimensionless) continue;
             if (!all.empty()) all += "; ";
             all += fmt::format("{}: {}", name_of(d), accepted_units(d));
         }
-        throw UnitError(fmt::format("unknown unit \"{}\" in \"{}\" (known units: {}; %)", s.unit, text, all));
+        throw UnitError(fmt::format("{} \"{}\" in \"{}\" (known units: {}; %{})", unit ? "no quantity of gpa's is in" : "unknown unit",
+                                    s.unit, text, all, compound_hint));
     }
-    return {to_double(s.number, unit, text), unit->dimension};
+    return {to_double(s.number, &*unit, text), *dimension};
+}
+
+std::optional<Quantity> compound_unit_value(std::string_view unit) {
+    const auto c = compound_unit(unit);
+    if (!c) return std::nullopt;
+    const auto dimension = dimension_of(c->exponents);
+    if (!dimension) return std::nullopt;
+    return Quantity{to_double(WrittenNumber{"1", 0, 1}, &*c, unit), *dimension};
 }
 
 }  // namespace gpa::io

@@ -161,5 +161,103 @@ TEST(Units, EverySpellingBelongsToOneDimension) {
     }
 }
 
+// Compound and customary units (issue 25, item 4): LS-DYNA's mm-ms-kg velocities, GN/m^2,
+// pound-force and inch units, spelt-out words, powers and products written with spaces.
+// Decimal compounds are exact (the prefixes join the exponent); customary ones are within one
+// rounding of their defining constants (1 ft = 0.3048 m, 1 lb = 0.45359237 kg, 1 lbf = 4.4482216152605 N,
+// all exact by definition): one rounding per factor and power (up to four), hence the relative
+// 1e-15 (about nine roundings of 1.1e-16) on those.
+TEST(Units, CompoundAndCustomaryUnits) {
+    const Case exact[] = {
+        {"1 mm/ms", D::Velocity, 1.0},
+        {"190 mm/ms", D::Velocity, 190.0},
+        {"0.5 m s^-1", D::Velocity, 0.5},
+        {"0.5 m*s^-1", D::Velocity, 0.5},
+        {"2 GN/m^2", D::Pressure, 2e9},
+        {"2 GN/m²", D::Pressure, 2e9},
+        {"3 N/mm^2", D::Pressure, 3e6},
+        {"3 kN/mm2", D::Pressure, 3e9},
+        {"7.85 g/mm^3", D::Density, 7.85e6},
+        {"7.85 mg/mm^3", D::Density, 7850.0},
+        {"40 microseconds", D::Time, 40e-6},
+        {"1 microsecond", D::Time, 1e-6},
+        {"2 milliseconds", D::Time, 0.002},
+        {"5 minutes", D::Time, 300.0},
+        {"1 hour", D::Time, 3600.0},
+        {"25 millimetres", D::Length, 0.025},
+        {"25 millimeters", D::Length, 0.025},
+        {"1 ft", D::Length, 0.3048},
+        {"1 foot", D::Length, 0.3048},
+        {"1 inch", D::Length, 0.0254},
+        {"1 ft/s", D::Velocity, 0.3048},
+        {"452 J kg^-1 K^-1", D::SpecificHeat, 452.0},
+        {"452 J/kg.K", D::SpecificHeat, 452.0},
+        {"452 m^2/s^2/K", D::SpecificHeat, 452.0},
+        {"2 kJ/g", D::SpecificEnergy, 2e6},
+        {"2 ms^-1", D::StrainRate, 2000.0},
+        {"0.5 %", D::Dimensionless, 0.005},
+        {"0.5 mm/m", D::Dimensionless, 0.0005},
+    };
+    for (const Case& c : exact) {
+        EXPECT_EQ(parse_quantity(c.text, c.dimension), c.si) << c.text;
+    }
+    const double lbf = 4.4482216152605, in = 0.0254;
+    const Case customary[] = {
+        {"1 psi", D::Pressure, lbf / (in * in)},
+        {"1 lbf/in^2", D::Pressure, lbf / (in * in)},
+        {"1 ksi", D::Pressure, 1000.0 * lbf / (in * in)},
+        {"1 lb/in^3", D::Density, 0.45359237 / (in * in * in)},
+        {"1 lb/ft^3", D::Density, 0.45359237 / (0.3048 * 0.3048 * 0.3048)},
+        {"1000 ft/s", D::Velocity, 304.8},
+        {"60 ksi", D::Pressure, 60000.0 * lbf / (in * in)},
+        {"0.284 lb/in^3", D::Density, 0.284 * 0.45359237 / (in * in * in)},
+        {"3 feet", D::Length, 0.9144},
+    };
+    for (const Case& c : customary) {
+        EXPECT_NEAR(parse_quantity(c.text, c.dimension), c.si, 1e-15 * c.si) << c.text;
+    }
+    EXPECT_NEAR(parse_quantity("1 ksi", D::Pressure), 6.894757293168361e6, 1.0) << "the ksi of the handbooks";
+}
+
+// The unit table: every listed unit that is a compound of base units reads the same as that
+// compound, value and dimension, so the table and the compound reader cannot drift apart.
+TEST(Units, EveryListedUnitReadsTheSameAsItsCompound) {
+    std::size_t compared = 0;
+    for (const Unit& u : known_units()) {
+        if (u.symbol == "%") continue;
+        const auto compound = compound_unit_value(u.symbol);
+        ASSERT_TRUE(compound.has_value()) << u.symbol << " is no compound of the base units";
+        const double listed = parse_quantity(fmt::format("1 {}", u.symbol), u.dimension);
+        EXPECT_EQ(compound->dimension, u.dimension) << u.symbol;
+        EXPECT_NEAR(compound->value, listed, 1e-15 * listed) << u.symbol;  // customary: as above
+        if (u.factor == 1.0) {
+            EXPECT_EQ(compound->value, listed) << u.symbol << ": decimal units are exact both ways";
+        }
+        ++compared;
+    }
+    EXPECT_GT(compared, 40u);
+}
+
+TEST(Units, CompoundsOfNoQuantityAndMalformedCompoundsAreRefused) {
+    const std::string acceleration = unit_error("9.8 m/s^2", D::Velocity);
+    EXPECT_NE(acceleration.find("which no scene value is"), std::string::npos) << acceleration;
+    EXPECT_NE(acceleration.find("m s^-2"), std::string::npos) << acceleration;
+    EXPECT_NE(acceleration.find("mm/ms"), std::string::npos) << acceleration << " (the compound hint)";
+    EXPECT_NE(acceleration.find("plain number in m/s"), std::string::npos) << acceleration;
+    for (const char* text : {"3 mm/", "3 /mm", "3 mm//s", "3 mm^", "3 mm^x", "3 mm^0", "3 kg/(m s", "3 (kg)/m",
+                             "3 kg/(m)(s)", "3 kK", "3 kin", "3 mft", "3 m..s", "3 1/", "3 1.m", "3 mm^99"}) {
+        EXPECT_THROW(parse_quantity(text, D::Length), UnitError) << text;
+        EXPECT_THROW(parse_any_quantity(text), UnitError) << text;
+    }
+    // A space between two names multiplies: "m s" is no millisecond.
+    EXPECT_NE(unit_error("3 m s", D::Time).find("which no scene value is"), std::string::npos);
+    EXPECT_EQ(parse_quantity("3 ms", D::Time), 0.003);
+    EXPECT_FALSE(compound_unit_value("m/s^2").has_value());
+    EXPECT_FALSE(compound_unit_value("furlong").has_value());
+    EXPECT_EQ(compound_unit_value("mm/ms")->dimension, D::Velocity);
+    // A compound of another dimension still says which it is.
+    EXPECT_NE(unit_error("3 lbf/in^2", D::Length).find("is a pressure, not a length"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace gpa::io

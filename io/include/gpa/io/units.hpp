@@ -7,6 +7,7 @@
 // to the exponent of the number as written and the result is rounded once, so "15.2 mm" gives
 // exactly the double nearest to 0.0152 (the same as writing 0.0152).
 
+#include <optional>
 #include <span>
 #include <stdexcept>
 #include <string>
@@ -45,8 +46,10 @@ struct Unit {
     bool alias = false;       // another spelling of a listed unit (not shown in messages)
 };
 
-// Every unit a scene may use. A symbol belongs to one dimension only. Spellings are matched
-// after removing spaces and reading '*' and the middle dot as '.', 'µ' and 'μ' as 'u', '³' as '^3'.
+// The units listed in messages and docs/scene-format.md. A symbol belongs to one dimension only.
+// Spellings are matched after removing spaces and reading '*' and the middle dot as '.', 'µ' and
+// 'μ' as 'u', '²' and '³' as '^2' and '^3'. A unit not listed is read as a compound of base units
+// (compound_unit_value).
 std::span<const Unit> known_units();
 
 // The accepted spellings of one dimension for messages, e.g. "m, cm, mm, um, in".
@@ -72,5 +75,17 @@ struct Quantity {
 
 // Reads a quantity of any dimension, taken from its unit; a bare number is dimensionless.
 Quantity parse_any_quantity(std::string_view text);
+
+// One unit read as a compound: products and quotients of the base units m, g, s, K, Pa, N, J, bar
+// (each with an optional SI prefix n, u, m, c, k, M, G), cc, min, h, in, ft, lb, lbf, psi, ksi
+// (and spelt-out words such as "microseconds" or "feet"), each with an optional integer power
+// ("m^3", "m3", "s^-1"); a space, '.', '*' or the middle dot multiplies, and everything after the
+// first '/' divides ("J/kg.K" and "J/(kg K)" are both J/(kg K); parentheses may enclose the whole
+// denominator only), with "1/s" for a numerator of one. Returns the SI value of one such unit and
+// its dimension; nullopt when the text is no such compound or its dimension is none of
+// Dimension's (an acceleration, "m/s^2"). The reader falls back on it for units known_units does
+// not list, so "mm/ms", "GN/m^2" and "lbf/in^2" are read, and every listed unit that is a compound
+// reads the same both ways (tests/io/test_units.cpp).
+std::optional<Quantity> compound_unit_value(std::string_view unit);
 
 }  // namespace gpa::io
