@@ -337,6 +337,8 @@ std::optional<Conversion> compound_unit(std::string_view written) {
         start = k + 1;
     }
     if (divisor != 1.0) total.factor /= divisor;
+    // Hundreds of customary factors overflow or underflow the product: no unit anyone writes.
+    if (!std::isfinite(total.factor) || !(total.factor > 0.0)) return std::nullopt;
     return total;
 }
 
@@ -462,7 +464,10 @@ double to_double(const WrittenNumber& n, const Conversion* unit, std::string_vie
     if (ec != std::errc{} || end != last) {
         throw UnitError(fmt::format("\"{}\" is not a number with a unit (write e.g. \"15.2 mm\")", text));
     }
-    if (unit && unit->factor != 1.0) value *= unit->factor;
+    if (unit && unit->factor != 1.0) {
+        value *= unit->factor;
+        if (!std::isfinite(value)) throw UnitError(fmt::format("\"{}\" is outside the range of a double", text));
+    }
     return value;
 }
 

@@ -253,6 +253,13 @@ TEST(Units, CompoundsOfNoQuantityAndMalformedCompoundsAreRefused) {
     EXPECT_NE(unit_error("3 m s", D::Time).find("which no scene value is"), std::string::npos);
     EXPECT_EQ(parse_quantity("3 ms", D::Time), 0.003);
     EXPECT_FALSE(compound_unit_value("m/s^2").has_value());
+    // Customary factors that overflow the product, cancelling in dimension: refused, not NaN.
+    std::string many_feet = "ft";
+    for (int k = 0; k < 700; ++k) many_feet += ".ft";
+    const std::string overflow = many_feet + "/" + many_feet;
+    EXPECT_FALSE(compound_unit_value(overflow).has_value());
+    EXPECT_THROW(parse_quantity("1 " + overflow, D::Dimensionless), UnitError);
+    EXPECT_THROW(parse_quantity("1e305 ksi", D::Pressure), UnitError);  // 1e308 as written, infinite in Pa
     EXPECT_FALSE(compound_unit_value("furlong").has_value());
     EXPECT_EQ(compound_unit_value("mm/ms")->dimension, D::Velocity);
     // A compound of another dimension still says which it is.
