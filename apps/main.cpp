@@ -179,7 +179,10 @@ int main(int argc, char** argv) {
     render->add_flag("--list", render_options.list, "list the snapshots and the fields of the chosen one, and draw nothing");
     render->add_flag("-q,--quiet", render_options.quiet, "print nothing when the picture is written");
 
-    auto* materials = app.add_subcommand("materials", "list the built-in material library");
+    std::vector<std::string> material_names;
+    auto* materials = app.add_subcommand("materials", "list the built-in material library, or print every constant of the named materials");
+    materials->add_option("names", material_names,
+                          "materials to print in full, as [[material]] tables a scene can use (letter case ignored)");
 
     int demo_threads = 0;
     std::string demo_output;
@@ -233,7 +236,7 @@ int main(int argc, char** argv) {
             if (!render_output.empty()) render_options.output = render_output;
             return gpa::app::render_run(render_options);
         }
-        if (materials->parsed()) return gpa::app::list_materials();
+        if (materials->parsed()) return gpa::app::list_materials(material_names);
         return gpa::app::run_demo(demo_threads, demo_output);
     } catch (const gpa::InputError& e) {
         fmt::print(stderr, "gpa: {}\n", e.what());

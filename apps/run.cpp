@@ -687,6 +687,19 @@ int check_scene(const fs::path& file, const MemoryLimit& memory) {
         fmt::print("  body \"{}\": {}, {} nodes{}, lattice spacing {} mm\n", scene.bodies[b].name, scene.bodies[b].material, count,
                    elements, fmt::join(spacing, " x "));
     }
+    // A material derived with `base`: what it changes, constant by constant.
+    for (const auto& material : scene.materials) {
+        if (material.base.empty()) continue;
+        const materials::Material* base = nullptr;
+        for (const auto& other : scene.materials) {
+            if (&other != &material && other.name == material.base) base = &other;
+        }
+        if (!base) base = io::find_builtin_material(material.base);
+        if (!base) continue;  // (the reader found it; a scene made in code may name anything)
+        const auto changes = io::material_changes(material, *base);
+        fmt::print("  material \"{}\": base \"{}\"{}{}\n", material.name, base->name,
+                   changes.empty() ? " unchanged" : ", with ", fmt::join(changes, ", "));
+    }
     for (std::size_t k = 0; k < scene.prescribed_velocities.size(); ++k) {
         const auto& r = scene.prescribed_velocities[k];
         std::string held;
@@ -702,15 +715,53 @@ int check_scene(const fs::path& file, const MemoryLimit& memory) {
     return 0;
 }
 
-int list_materials() {
+namespace {
+
+std::string eos_summary(const materials::EquationOfState& eos) {
+    if (const auto* linear = std::get_if<materials::LinearEos>(&eos)) {
+        return fmt::format("linear EOS K {:.4g} GPa{}", linear->bulk_modulus / 1e9, linear->logarithmic ? " (logarithmic)" : "");
+    }
+    if (const auto* poly = std::get_if<materials::PolynomialEos>(&eos)) {
+        return fmt::format("polynomial EOS K1 {:.4g} GPa, Gamma0 {}", poly->k1 / 1e9, poly->gruneisen);
+    }
+    const auto& mg = std::get<materials::MieGruneisenEos>(eos);
+    return fmt::format("Mie-Grueneisen EOS c0 {} m/s, s {}, Gamma0 {}", mg.sound_speed, mg.slope, mg.gruneisen);
+}
+
+std::string failure_summary(const materials::Failure& f) {
+    std::string out;
+    if (f.johnson_cook) {
+        out = fmt::format("Johnson-Cook fracture D1-D5 {}, {}, {}, {}, {}", f.johnson_cook->d1, f.johnson_cook->d2, f.johnson_cook->d3,
+                          f.johnson_cook->d4, f.johnson_cook->d5);
+    }
+    if (f.spall_pressure) out += fmt::format("{}spall at {:.4g} GPa", out.empty() ? "" : "; ", *f.spall_pressure / 1e9);
+    return out.empty() ? "no failure model" : out;
+}
+
+}  // namespace
+
+int list_materials(const std::vector<std::string>& names) {
+    if (!names.empty()) {
+        // Every name is checked before anything is printed.
+        std::vector<const materials::Material*> chosen;
+        for (const auto& name : names) chosen.push_back(&io::builtin_material(name));
+        for (std::size_t k = 0; k < chosen.size(); ++k) {
+            fmt::print("{}# {}: built-in material (materials/data/library.toml). A scene uses it by name, derives from it\n"
+                       "# with base = \"{}\" and changes only what differs, or copies this table and edits it.\n{}",
+                       k > 0 ? "\n" : "", chosen[k]->name, chosen[k]->name, io::material_as_toml(*chosen[k]));
+        }
+        return 0;
+    }
     for (const auto& m : io::builtin_materials()) {
         fmt::print("{}\n  density {} kg/m^3, shear modulus {:.4g} GPa, specific heat {} J/(kg K), melt {} K\n", m.name,
                    m.density, m.shear_modulus / 1e9, m.specific_heat, m.melt_temperature);
         if (const auto* jc = std::get_if<materials::JohnsonCookStrength>(&m.strength)) {
             fmt::print("  Johnson-Cook A {:.4g} MPa, B {:.4g} MPa, n {}, C {}, m {}\n", jc->a / 1e6, jc->b / 1e6, jc->n, jc->c, jc->m);
         }
+        fmt::print("  {}; {}\n", eos_summary(m.eos), failure_summary(m.failure));
         fmt::print("  source: {}\n", m.source);
     }
+    fmt::print("\nEvery constant of one, as a table a scene can use: gpa materials \"NAME\"\n");
     return 0;
 }
 

@@ -35,6 +35,8 @@ int run_scene(const RunOptions& options);
 // Reads and checks a scene without running it: builds its nodes and prints what it holds.
 int check_scene(const std::filesystem::path& scene, const MemoryLimit& memory = {});
 // Lists the built-in material library.
-int list_materials();
+// `gpa materials`: one paragraph per built-in material; with names, every constant of each as a
+// [[material]] table (io::material_as_toml). An unknown name is an InputError listing the library.
+int list_materials(const std::vector<std::string>& names);
 
 }  // namespace gpa::app

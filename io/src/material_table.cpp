@@ -286,6 +286,7 @@ m::Material read_material(const Reporter& reporter, const toml::table& table, st
 
     m::Material mat = base ? *base : m::Material{};
     mat.name = name;
+    mat.base = base ? base->name : std::string();
     if (const auto v = r.quantity("density", D::Density, Limit::Positive)) mat.density = *v;
     if (const auto v = r.quantity("shear_modulus", D::Pressure, Limit::NonNegative)) mat.shear_modulus = *v;
     if (const auto v = r.quantity("specific_heat", D::SpecificHeat, Limit::NonNegative)) mat.specific_heat = *v;

@@ -66,6 +66,21 @@ expect 0 "overwrite" -- "$gpa" run "$src/tests/cli/tiny.toml" -o keep --overwrit
 # 5. The library listing and a good check.
 expect 0 "materials" -- "$gpa" materials
 for m in "OFHC copper" "Armco iron" "4340 steel" "2024-T351"; do grep -q "$m" out.txt || fail "materials lacks $m"; done
+# Every constant of a named material, as a [[material]] table that a scene can use as it is.
+expect 0 "materials NAME" -- "$gpa" materials "4340 STEEL"
+grep -q '^name = "4340 steel"$' out.txt || fail "materials NAME does not print the table: $(head -c 300 out.txt)"
+for key in density shear_modulus specific_heat melt_temperature eos strength failure.johnson_cook source; do
+  grep -q "^$key = " out.txt || fail "materials NAME lacks $key"
+done
+sed 's/^material = "elastic steel"$/material = "pasted steel"/' "$src/tests/cli/tiny.toml" > pasted.toml
+sed 's/^name = "4340 steel"$/name = "pasted steel"/' out.txt >> pasted.toml
+expect 0 "a scene with the printed table" -- "$gpa" check pasted.toml
+expect 2 "materials of an unknown name" -- "$gpa" materials "4340 steel" "6061-T5"
+grep -q '6061-T5' err.txt || fail "unknown material not named: $(cat err.txt)"
+[[ -s out.txt ]] && fail "materials printed something before refusing an unknown name"
+expect 0 "check good scene" -- "$gpa" check "$src/scenes/hypervelocity-small.toml"
+grep -qF 'material "Armco iron (shock)": base "Armco iron", with eos.model = "mie-gruneisen" (base: "polynomial")' out.txt ||
+  fail "check does not show what a derived material changes: $(grep material out.txt)"
 expect 0 "check good scene" -- "$gpa" check "$src/scenes/taylor-copper-190.toml"
 # The first time step of the 0.254 mm copper bar is tens of nanoseconds (c about 4 km/s): a
 # "0 ns" there would mean the check printed a step not yet computed.

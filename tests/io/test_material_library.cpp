@@ -1,7 +1,10 @@
 // The built-in material library holds the constants of shared/spec/materials.md, with sources,
 // and is embedded in the program (it equals materials/data/library.toml).
 
+#include <algorithm>
+#include <cstring>
 #include <fstream>
+#include <tuple>
 #include <sstream>
 #include <string>
 #include <variant>
@@ -138,6 +141,144 @@ room_temperature = "500 K"
     EXPECT_EQ(materials[1].room_temperature, 500.0);
     EXPECT_EQ(materials[1].density, 8960.0);
     EXPECT_THROW(parse_material_library("[[material]]\nname = \"x\"\nbase = \"y\"\n", "mine.toml"), SceneError);
+}
+
+// Bit for bit: a printed number must read back as the same double (its unit's power of ten is
+// moved into the decimal point, never multiplied).
+bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+void expect_same_material(const m::Material& a, const m::Material& b) {
+    SCOPED_TRACE(a.name);
+    EXPECT_EQ(a.name, b.name);
+    EXPECT_EQ(a.source, b.source);
+    for (const auto& [x, y, what] : {std::tuple{a.density, b.density, "density"},
+                                     std::tuple{a.shear_modulus, b.shear_modulus, "shear modulus"},
+                                     std::tuple{a.specific_heat, b.specific_heat, "specific heat"},
+                                     std::tuple{a.taylor_quinney, b.taylor_quinney, "Taylor-Quinney"},
+                                     std::tuple{a.room_temperature, b.room_temperature, "room temperature"},
+                                     std::tuple{a.melt_temperature, b.melt_temperature, "melt temperature"}}) {
+        EXPECT_TRUE(same_bits(x, y)) << what << ": " << x << " printed and read back as " << y;
+    }
+    ASSERT_EQ(a.eos.index(), b.eos.index());
+    ASSERT_EQ(a.strength.index(), b.strength.index());
+    const auto bits = [](const auto& v) {
+        std::vector<double> out;
+        std::visit([&](const auto& model) {
+            if constexpr (std::is_same_v<std::decay_t<decltype(model)>, m::LinearEos>) {
+                out = {model.bulk_modulus, model.logarithmic ? 1.0 : 0.0};
+            } else if constexpr (std::is_same_v<std::decay_t<decltype(model)>, m::PolynomialEos>) {
+                out = {model.k1, model.k2, model.k3, model.gruneisen};
+            } else if constexpr (std::is_same_v<std::decay_t<decltype(model)>, m::MieGruneisenEos>) {
+                out = {model.sound_speed, model.slope, model.gruneisen};
+            } else if constexpr (std::is_same_v<std::decay_t<decltype(model)>, m::VonMisesStrength>) {
+                out = {model.yield_stress, model.hardening_modulus};
+            } else if constexpr (std::is_same_v<std::decay_t<decltype(model)>, m::JohnsonCookStrength>) {
+                out = {model.a, model.b, model.n, model.c, model.m, model.reference_strain_rate};
+            }
+        }, v);
+        return out;
+    };
+    const auto compare = [&](const std::vector<double>& x, const std::vector<double>& y, const char* what) {
+        ASSERT_EQ(x.size(), y.size()) << what;
+        for (std::size_t k = 0; k < x.size(); ++k) EXPECT_TRUE(same_bits(x[k], y[k])) << what << " constant " << k << ": " << x[k] << " vs " << y[k];
+    };
+    compare(bits(a.eos), bits(b.eos), "equation of state");
+    compare(bits(a.strength), bits(b.strength), "strength");
+    ASSERT_EQ(a.failure.johnson_cook.has_value(), b.failure.johnson_cook.has_value());
+    if (a.failure.johnson_cook) {
+        const auto& f = *a.failure.johnson_cook;
+        const auto& g = *b.failure.johnson_cook;
+        compare({f.d1, f.d2, f.d3, f.d4, f.d5, f.reference_strain_rate, f.min_failure_strain},
+                {g.d1, g.d2, g.d3, g.d4, g.d5, g.reference_strain_rate, g.min_failure_strain}, "Johnson-Cook fracture");
+    }
+    ASSERT_EQ(a.failure.spall_pressure.has_value(), b.failure.spall_pressure.has_value());
+    if (a.failure.spall_pressure) {
+        EXPECT_TRUE(same_bits(*a.failure.spall_pressure, *b.failure.spall_pressure));
+    }
+}
+
+// `gpa materials NAME` prints every constant as a [[material]] table; read back, it is the same
+// material bit for bit: every library material, and made-up ones with every model, awkward
+// numbers (17 significant digits, tiny and huge, negative) and quotes in their text.
+TEST(MaterialLibrary, EveryMaterialPrintsAsATableThatReadsBackBitForBit) {
+    std::vector<m::Material> materials = builtin_materials();
+    m::Material odd;
+    odd.name = "odd \"quoted\" \\ name";
+    odd.source = "line one\nline two, with a tab\tand \"quotes\"";
+    odd.density = 1234.5678901234567;
+    odd.shear_modulus = 0.1 + 0.2;  // 0.30000000000000004 Pa
+    odd.specific_heat = 0.0;
+    odd.taylor_quinney = 1.0 / 3.0;
+    odd.room_temperature = 293.15;
+    odd.eos = m::LinearEos{2.5e10 / 3.0, true};
+    odd.strength = m::VonMisesStrength{7.0e8 / 3.0, 1e-3};
+    odd.failure.spall_pressure = 1.5e9;
+    materials.push_back(odd);
+    m::Material poly = odd;
+    poly.name = "polynomial";
+    poly.melt_temperature = 1e4 / 7.0;
+    poly.eos = m::PolynomialEos{165e9, -1.23456789e11, 9.87654321e12, 1.7};
+    poly.strength = m::ElasticStrength{};
+    poly.failure = {};
+    materials.push_back(poly);
+    m::Material jc = builtin_material("4340 steel");
+    jc.name = "johnson-cook at odd rates";
+    std::get<m::JohnsonCookStrength>(jc.strength).reference_strain_rate = 5e-4;
+    jc.failure.johnson_cook->reference_strain_rate = 1.0 / 3.0;
+    jc.failure.johnson_cook->d4 = -0.015;
+    jc.failure.johnson_cook->min_failure_strain = 1e-9;
+    jc.failure.spall_pressure = 2.9e9;
+    materials.push_back(jc);
+    for (const auto& material : materials) {
+        const std::string text = material_as_toml(material);
+        std::vector<m::Material> read;
+        ASSERT_NO_THROW(read = parse_material_library(text, "printed.toml")) << text;
+        ASSERT_EQ(read.size(), 1u);
+        expect_same_material(material, read.front());
+    }
+    // The library's own units, as a reader of the table expects them.
+    const std::string copper = material_as_toml(builtin_material("OFHC copper"));
+    EXPECT_NE(copper.find("a = \"90 MPa\""), std::string::npos) << copper;
+    EXPECT_NE(copper.find("shear_modulus = \"46 GPa\""), std::string::npos) << copper;
+    EXPECT_NE(copper.find("sound_speed = \"3940 m/s\""), std::string::npos) << copper;
+}
+
+// `gpa check` shows what a material derived with `base` changes: exactly the constants the table
+// sets to other values, a changed model's constants, and the base's that are gone.
+TEST(MaterialLibrary, ADerivedMaterialListsWhatItChanges) {
+    const auto derived = parse_material_library(R"(
+[[material]]
+name = "hot copper"
+base = "OFHC copper"
+strength = { a = "120 MPa", n = 0.31 }
+room_temperature = "400 K"
+
+[[material]]
+name = "copper, linear"
+base = "hot copper"
+eos = { model = "linear", bulk_modulus = "140 GPa" }
+failure = "none"
+)", "derived.toml");
+    ASSERT_EQ(derived.size(), 2u);
+    EXPECT_EQ(derived[0].base, "OFHC copper");
+    EXPECT_EQ(derived[1].base, "hot copper");
+    EXPECT_TRUE(builtin_material("OFHC copper").base.empty());
+    // n = 0.31 is the base's value: no change.
+    EXPECT_EQ(material_changes(derived[0], builtin_material("OFHC copper")),
+              (std::vector<std::string>{"room_temperature = \"400 K\" (base: \"294 K\")",
+                                        "strength.a = \"120 MPa\" (base: \"90 MPa\")"}));
+    const auto second = material_changes(derived[1], derived[0]);
+    const std::vector<std::string> expected{
+        "eos.model = \"linear\" (base: \"mie-gruneisen\")", "eos.bulk_modulus = \"140 GPa\" (base: none)",
+        "eos.logarithmic = false (base: none)",             "failure = \"none\" (base: none)",
+        "no eos.sound_speed (base: \"3940 m/s\")",          "no eos.slope (base: 1.489)",
+        "no eos.gruneisen (base: 2.02)",                    "no failure.johnson_cook.d1 (base: 0.54)",
+    };
+    for (const auto& line : expected) {
+        EXPECT_NE(std::find(second.begin(), second.end(), line), second.end()) << line << " missing from " << testing::PrintToString(second);
+    }
+    EXPECT_EQ(second.size(), 4u + 3u + 7u) << testing::PrintToString(second);  // the model and 3 new keys; 3 EOS and 7 fracture constants gone
+    EXPECT_TRUE(material_changes(derived[0], derived[0]).empty());
 }
 
 }  // namespace

@@ -101,6 +101,7 @@ double johnson_cook_failure_strain(const JohnsonCookFailure& f, double triaxiali
 struct Material {
     std::string name;
     std::string source;  // where the constants come from, and which were not checked
+    std::string base;    // the material this one was derived from (a scene's `base`), empty if none; descriptive only
     double density = 0.0;           // rho0, kg/m^3: sets nodal masses and the EOS reference alike
     double shear_modulus = 0.0;     // G, Pa
     double specific_heat = 0.0;     // c_p, J/(kg K); 0 = no temperature rise
