@@ -33,7 +33,7 @@ const std::vector<std::string_view> scene_keys{
 const std::vector<std::string_view> body_keys{
     "name",    "shape",     "material", "origin",         "size",         "radius",            "diameter",
     "length",  "spacing",   "spacing_z", "velocity",      "initial_stress", "connectivity",    "lattice_neighbours",
-    "discretisation", "inner_radius",
+    "discretisation", "inner_radius", "nose",
 };
 const std::vector<std::string_view> plane_keys{"name", "kind", "axis", "position", "side", "lift_off"};
 const std::vector<std::string_view> prescribed_keys{"name", "body", "region", "velocity", "ramp"};
@@ -254,6 +254,42 @@ BodySpec read_body(const Reporter& reporter, const toml::table& table, std::size
             r.fail_at("inner_radius", fmt::format("{} m must be less than the radius, {} m: nothing would be left of the {}",
                                                   b.inner_radius, b.radius, geometry == GeometryKind::PlaneStrain ? "ring" : "shell"));
         }
+    }
+
+    if (const toml::node* nose = r.find("nose")) {
+        if (b.shape != ShapeKind::Cylinder) r.fail_at("nose", fmt::format("applies to a cylinder only, not a {}", shape_name));
+        const auto* nose_table = nose->as_table();
+        if (!nose_table) {
+            r.fail_at("nose", fmt::format("expected a table such as {{ shape = \"cone\", length = \"10 mm\" }}, got {}",
+                                          as_written(*nose)));
+        }
+        const TableReader t(reporter, *nose_table, r.key_path("nose"), "a nose", {"shape", "length", "calibre_radius", "end"});
+        NoseSpec n;
+        const auto kind = t.choice<NoseKind>("shape", {{"cone", NoseKind::Cone}, {"hemisphere", NoseKind::Hemisphere},
+                                                       {"ogive", NoseKind::Ogive}});
+        if (!kind) t.fail_missing("shape", "cone, hemisphere or ogive");
+        n.kind = *kind;
+        if (n.kind == NoseKind::Cone) {
+            n.length = t.required_quantity("length", D::Length, Limit::Positive);
+        } else if (t.has("length")) {
+            t.fail_at("length", fmt::format("a {} nose's length follows from the radius{}; leave it out", name_of(n.kind),
+                                            n.kind == NoseKind::Ogive ? " and calibre_radius" : ""));
+        }
+        if (n.kind == NoseKind::Ogive) {
+            n.calibre_radius = t.required_quantity("calibre_radius", D::Dimensionless, Limit::Positive);
+            if (!(n.calibre_radius >= 0.5)) {
+                t.fail_at("calibre_radius", fmt::format("{} is below 0.5: the arc radius of a tangent ogive is at least the "
+                                                        "cylinder's radius (0.5 calibres is a hemisphere)", n.calibre_radius));
+            }
+        } else if (t.has("calibre_radius")) {
+            t.fail_at("calibre_radius", fmt::format("applies to an ogive only, not a {}", name_of(n.kind)));
+        }
+        if (const auto end = t.choice<int>("end", {{"bottom", -1}, {"top", 1}})) n.end = *end;
+        if (!(nose_length(n, b.radius) <= b.length)) {
+            t.fail_table(fmt::format("the {} nose is {:.6g} mm long, longer than the cylinder's length, {:.6g} mm (the nose "
+                                     "is part of it)", name_of(n.kind), nose_length(n, b.radius) * 1e3, b.length * 1e3));
+        }
+        b.nose = n;
     }
 
     b.spacing = r.required_quantity("spacing", D::Length, Limit::Positive);

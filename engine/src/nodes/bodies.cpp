@@ -47,6 +47,13 @@ LatticeBlock body_lattice(const Scene& scene, std::size_t index) {
                 block.origin = {axisymmetric ? 0.0 : o[0] - b.radius, o[1], 0.0};
                 block.spacing = {sx, sz, 1.0};
                 block.last = {nx, nz, 1};
+                if (b.nose) {
+                    // The nose: cells whose centre lies within its profile (scene.hpp, cylinder_radius_at).
+                    const double cx = axisymmetric ? 0.0 : o[0], z0 = o[1];
+                    block.inside = [=](const std::array<double, 3>& p) {
+                        return std::abs(p[0] - cx) < cylinder_radius_at(b, p[1] - z0);
+                    };
+                }
                 break;
             }
             case ShapeKind::Rectangle: {
@@ -84,8 +91,10 @@ LatticeBlock body_lattice(const Scene& scene, std::size_t index) {
                 block.spacing = {s, s, s};
                 block.first = {-half, -half, 0};
                 block.last = {half, half, nz};
+                const double z0 = o[2];
                 block.inside = [=](const std::array<double, 3>& p) {
-                    return (p[0] - cx) * (p[0] - cx) + (p[1] - cy) * (p[1] - cy) < r * r;
+                    const double radius = b.nose ? cylinder_radius_at(b, p[2] - z0) : r;
+                    return (p[0] - cx) * (p[0] - cx) + (p[1] - cy) * (p[1] - cy) < radius * radius;
                 };
                 break;
             }

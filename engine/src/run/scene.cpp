@@ -96,8 +96,9 @@ bool inside_shape(const BodySpec& b, GeometryKind g, const std::array<double, 3>
         case ShapeKind::Plate: {
             const double z0 = o[static_cast<std::size_t>(dim - 1)];
             if (!(z > z0 && z < z0 + b.length)) return false;
-            if (dim == 2) return g == GeometryKind::Axisymmetric ? p[0] < b.radius : std::abs(p[0] - o[0]) < b.radius;
-            return (p[0] - o[0]) * (p[0] - o[0]) + (p[1] - o[1]) * (p[1] - o[1]) < b.radius * b.radius;
+            const double r = cylinder_radius_at(b, z - z0);
+            if (dim == 2) return g == GeometryKind::Axisymmetric ? p[0] < r : std::abs(p[0] - o[0]) < r;
+            return (p[0] - o[0]) * (p[0] - o[0]) + (p[1] - o[1]) * (p[1] - o[1]) < r * r;
         }
         case ShapeKind::Sphere: {
             double q = 0.0;
@@ -235,6 +236,33 @@ void check_body(const Scene& scene, const BodySpec& b, std::size_t i) {
         if (g == GeometryKind::Axisymmetric && b.origin[0] != 0.0) {
             fail(fmt::format("{}.origin: an axisymmetric {} lies on the axis, so its origin x must be 0 (is {} m)", label,
                              name_of(b.shape), b.origin[0]));
+        }
+        if (b.nose) {
+            // The nose (scene.hpp, NoseSpec): on a cylinder, within its length, of a profile that exists.
+            const NoseSpec& n = *b.nose;
+            if (b.shape != ShapeKind::Cylinder) {
+                fail(fmt::format("{}.nose applies to a cylinder only, not a {}", label, name_of(b.shape)));
+            }
+            if (n.end != -1 && n.end != 1) fail(fmt::format("{}.nose.end = {} must be -1 (bottom) or 1 (top)", label, n.end));
+            if (n.kind == NoseKind::Cone && !(n.length > 0.0 && finite(n.length))) {
+                fail(fmt::format("{}.nose.length = {} must be a positive length (m) for a cone", label, n.length));
+            }
+            if (n.kind != NoseKind::Cone && n.length != 0.0) {
+                fail(fmt::format("{}.nose.length: a {} nose's length follows from the radius{}; give none", label,
+                                 name_of(n.kind), n.kind == NoseKind::Ogive ? " and calibre_radius" : ""));
+            }
+            if (n.kind == NoseKind::Ogive && !(n.calibre_radius >= 0.5 && finite(n.calibre_radius))) {
+                fail(fmt::format("{}.nose.calibre_radius = {} must be at least 0.5 (calibres: the arc radius over the diameter; "
+                                 "0.5 is a hemisphere)", label, n.calibre_radius));
+            }
+            if (n.kind != NoseKind::Ogive && n.calibre_radius != 0.0) {
+                fail(fmt::format("{}.nose.calibre_radius applies to an ogive only, not a {}", label, name_of(n.kind)));
+            }
+            const double length = nose_length(n, b.radius);
+            if (!(length <= b.length)) {
+                fail(fmt::format("{}: its {} nose is {} m long, longer than the cylinder ({} m, the nose included)", label,
+                                 name_of(n.kind), length, b.length));
+            }
         }
         if (b.inner_radius != 0.0) {
             if (b.shape != ShapeKind::Sphere) {
@@ -579,6 +607,46 @@ std::string_view name_of(Discretisation d) {
 }
 
 bool is_round(ShapeKind s) { return s == ShapeKind::Cylinder || s == ShapeKind::Plate || s == ShapeKind::Sphere; }
+
+std::string_view name_of(NoseKind k) {
+    switch (k) {
+        case NoseKind::Cone: return "cone";
+        case NoseKind::Hemisphere: return "hemisphere";
+        case NoseKind::Ogive: return "ogive";
+    }
+    return "?";
+}
+
+double nose_length(const NoseSpec& nose, double radius) {
+    switch (nose.kind) {
+        case NoseKind::Cone: return nose.length;
+        case NoseKind::Hemisphere: return radius;
+        case NoseKind::Ogive: {
+            const double rho = nose.calibre_radius * 2.0 * radius;
+            return std::sqrt(rho * rho - (rho - radius) * (rho - radius));
+        }
+    }
+    return 0.0;
+}
+
+double cylinder_radius_at(const BodySpec& b, double height) {
+    if (!(height >= 0.0 && height <= b.length)) return 0.0;
+    if (!b.nose) return b.radius;
+    const double nose = nose_length(*b.nose, b.radius);
+    // s: the distance into the nose from its base (negative on the shank).
+    const double s = b.nose->end < 0 ? nose - height : height - (b.length - nose);
+    if (s <= 0.0) return b.radius;
+    const double R = b.radius;
+    switch (b.nose->kind) {
+        case NoseKind::Cone: return R * (1.0 - s / nose);
+        case NoseKind::Hemisphere: return std::sqrt(std::max(R * R - s * s, 0.0));
+        case NoseKind::Ogive: {
+            const double rho = b.nose->calibre_radius * 2.0 * R;
+            return std::max(std::sqrt(std::max(rho * rho - s * s, 0.0)) - (rho - R), 0.0);
+        }
+    }
+    return R;
+}
 
 void validate_scene(const Scene& scene) {
     const GeometryKind g = scene.geometry;

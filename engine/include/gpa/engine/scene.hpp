@@ -61,6 +61,31 @@ enum class Discretisation { Particles, Elements };
 
 std::string_view name_of(Discretisation d);
 
+// The shaped end of a cylinder: a projectile's nose (Borvik et al. fired blunt, hemispherical and
+// conical ones; tangent ogives are the usual long-rod and bullet shape). The nose is part of the
+// cylinder's `length`, at its lower z end (end = -1, a projectile flying towards -z) or its upper.
+// Its cross-section's radius at distance s from the nose's base, R the cylinder's radius and L the
+// nose length:
+//   cone        r = R (1 - s / L)
+//   hemisphere  r = sqrt(R^2 - s^2),                   L = R
+//   ogive       r = sqrt(rho^2 - s^2) - (rho - R),     L = sqrt(rho^2 - (rho - R)^2)
+// the ogive tangent to the shank, of arc radius rho = calibre_radius * 2 R (its "calibre radius
+// head", CRH; >= 0.5, where 0.5 is the hemisphere). In plane strain the same profile bounds a slab
+// (a wedge, a half disc).
+enum class NoseKind { Cone, Hemisphere, Ogive };
+
+struct NoseSpec {
+    NoseKind kind = NoseKind::Cone;
+    double length = 0.0;          // cone: given (m); hemisphere and ogive: 0 (nose_length gives it)
+    double calibre_radius = 0.0;  // ogive only: rho / (2 R)
+    int end = -1;                 // -1: at the lower z end, +1: at the upper
+};
+
+std::string_view name_of(NoseKind k);
+
+// The nose's length along z (NoseSpec), for a cylinder of radius `radius`.
+double nose_length(const NoseSpec& nose, double radius);
+
 struct BodySpec {
     std::string name;
     Discretisation discretisation = Discretisation::Particles;
@@ -68,12 +93,14 @@ struct BodySpec {
     // Cylinder/plate: origin is the centre of the base (lower z end); Rectangle/box: lower
     // corner; Sphere: centre. Axisymmetric cylinders, plates and spheres must have origin x = 0.
     std::array<double, 3> origin{0, 0, 0};
+
     std::array<double, 3> size{0, 0, 0};  // rectangle/box
     double radius = 0.0;                  // cylinder/plate/sphere
     // Sphere only: the radius of a hollow core, 0 = solid. A hollow sphere in 3D and in axisymmetric
     // geometry, an annulus (a ring) in plane strain.
     double inner_radius = 0.0;
-    double length = 0.0;                  // cylinder/plate, along z
+    double length = 0.0;                  // cylinder/plate, along z (a nose included)
+    std::optional<NoseSpec> nose;         // cylinder only: its shaped end; none = flat ends
     double spacing = 0.0;                 // lattice spacing dx (and dy, dz in 3D)
     double spacing_z = 0.0;               // 2D: dz; 0 = equal to dx
     std::string material;                 // a name in Scene::materials
@@ -84,6 +111,12 @@ struct BodySpec {
     std::optional<ConnectivityMode> connectivity;  // overrides SolverOptions::connectivity (particles only)
     int lattice_neighbours = 0;                    // fixed lists: 4/8 (2D), 6/18/26 (3D); 0 = 8 or 26 (particles only)
 };
+
+// The radius of cylinder (or plate) b's cross-section at `height` above its base (z minus the
+// origin's z): b.radius along the shank, the nose's profile (NoseSpec) over the nose, 0 outside
+// [0, length]. A lattice node belongs to the body when its cell centre lies within it
+// (docs/scene-format.md).
+double cylinder_radius_at(const BodySpec& b, double height);
 
 enum class PlaneKind {
     Rigid,     // a frictionless rigid wall; pushes only unless lift_off is false
