@@ -12,7 +12,8 @@
 namespace gpa::io {
 
 // The library's materials in file order: OFHC copper, Armco iron, 4340 steel, 2024-T351
-// aluminium. Parsed once, on first use.
+// aluminium (the spec's), Weldox 460 E, 6061-T6 and 7075-T6 aluminium, Ti-6Al-4V, tungsten heavy
+// alloy. Parsed once, on first use.
 const std::vector<materials::Material>& builtin_materials();
 
 // The library material of that name, letter case ignored; nullptr if there is none.
