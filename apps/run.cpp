@@ -57,6 +57,7 @@ constexpr const char* builtin_label = "(built-in default)";  // the summary's sc
 // default_scene_file) and says, whatever --quiet, when one is not there (io::resolve_scene_files).
 void resolve_files(Scene& scene, const fs::path& scene_file) {
     if (const std::string warning = io::resolve_scene_files(scene, scene_file); !warning.empty()) spdlog::warn("{}", warning);
+    for (const std::string& odd : scene_warnings(scene)) spdlog::warn("{}: {}", scene_file.string(), odd);
 }
 
 SceneSource read_source(const std::optional<fs::path>& file) {
@@ -668,6 +669,9 @@ fs::path default_output_folder(const std::string& root, const std::string& scene
 int check_scene(const fs::path& file, const MemoryLimit& memory) {
     std::string warning;
     const Scene scene = io::load_scene(file, &warning);
+    // Implausible values first: a unit slip in a size may make the set-up below refuse the scene
+    // for its memory, and the user should see why.
+    for (const std::string& odd : scene_warnings(scene)) spdlog::warn("{}: {}", file.string(), odd);
     Simulation sim(scene, 1, memory);  // builds the nodes: every check of set-up runs
     fmt::print("{}: OK\n", file.string());
     fmt::print("  {} ({}), {} bod{}, {} real nodes, {} ghost nodes at the start\n", scene.name, name_of(scene.geometry),

@@ -78,6 +78,10 @@ expect 0 "a scene with the printed table" -- "$gpa" check pasted.toml
 expect 2 "materials of an unknown name" -- "$gpa" materials "4340 steel" "6061-T5"
 grep -q '6061-T5' err.txt || fail "unknown material not named: $(cat err.txt)"
 [[ -s out.txt ]] && fail "materials printed something before refusing an unknown name"
+# An implausible value is a warning that names it (a unit slip), not a refusal.
+sed 's/"-50 m\/s"/"-50 km\/s"/' "$src/tests/cli/tiny.toml" > fast.toml
+expect 0 "check a scene at 50 km/s" -- "$gpa" check fast.toml
+grep -q 'a speed of 50 km/s is beyond any impact experiment' out.txt || fail "no warning for 50 km/s: $(cat out.txt)"
 expect 0 "check good scene" -- "$gpa" check "$src/scenes/hypervelocity-small.toml"
 grep -qF 'material "Armco iron (shock)": base "Armco iron", with eos.model = "mie-gruneisen" (base: "polynomial")' out.txt ||
   fail "check does not show what a derived material changes: $(grep material out.txt)"

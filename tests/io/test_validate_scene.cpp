@@ -1,6 +1,7 @@
 // validate_scene gives an embedder who builds a Scene in code the same rules a scene file gets,
 // with messages naming the body, plane, material or option.
 
+#include <filesystem>
 #include <functional>
 #include <limits>
 #include <string>
@@ -10,6 +11,7 @@
 #include "gpa/engine/errors.hpp"
 #include "gpa/engine/scene.hpp"
 #include "gpa/io/material_library.hpp"
+#include "gpa/io/scene_file.hpp"
 
 namespace gpa {
 namespace {
@@ -57,6 +59,44 @@ std::string message_after(const std::function<void(Scene&)>& change) {
     } while (0)
 
 TEST(ValidateScene, TaylorSceneBuiltInCodePasses) { EXPECT_NO_THROW(validate_scene(taylor_scene())); }
+
+// Implausible but valid values are warned about, one message each, naming what to check; the
+// shipped scenes and the Taylor scene have none.
+TEST(SceneWarnings, NameImplausibleSpeedsSizesAndEndTimes) {
+    EXPECT_TRUE(scene_warnings(taylor_scene()).empty());
+    const auto warned = [](const std::function<void(Scene&)>& change) {
+        Scene s = taylor_scene();
+        change(s);
+        EXPECT_NO_THROW(validate_scene(s)) << "a warning is no refusal";
+        return scene_warnings(s);
+    };
+    auto w = warned([](Scene& s) { s.bodies[0].velocity = {0, -190e3, 0}; });
+    ASSERT_EQ(w.size(), 1u);
+    EXPECT_NE(w[0].find("body \"bar\" (body[0]): a speed of 190 km/s"), std::string::npos) << w[0];
+    EXPECT_NE(w[0].find("check its unit"), std::string::npos) << w[0];
+    EXPECT_TRUE(warned([](Scene& s) { s.bodies[0].velocity = {0, -19e3, 0}; }).empty()) << "19 km/s may be meant";
+    w = warned([](Scene& s) {
+        s.bodies[0].radius = 3.81;  // the copper bar in m where mm were meant
+        s.bodies[0].length = 25.4;
+        s.bodies[0].spacing = 0.254;
+    });
+    ASSERT_EQ(w.size(), 1u);
+    EXPECT_NE(w[0].find("it is 25.4 m across, larger than"), std::string::npos) << w[0];
+    w = warned([](Scene& s) {
+        s.bodies[0].radius = 3.81e-6;  // and in um
+        s.bodies[0].length = 25.4e-6;
+        s.bodies[0].spacing = 0.254e-6;
+    });
+    ASSERT_EQ(w.size(), 1u);
+    EXPECT_NE(w[0].find("it is 7.62 um across, smaller than"), std::string::npos) << w[0];
+    w = warned([](Scene& s) { s.stop.end_time = 150.0; });
+    ASSERT_EQ(w.size(), 1u);
+    EXPECT_NE(w[0].find("stop.end_time: 150 s"), std::string::npos) << w[0];
+    for (const auto& entry : std::filesystem::directory_iterator(GPA_SCENES_DIR)) {
+        if (entry.path().extension() != ".toml") continue;
+        EXPECT_TRUE(scene_warnings(io::load_scene(entry.path())).empty()) << entry.path();
+    }
+}
 
 TEST(ValidateScene, BodiesMayTouchButNotOverlap) {
     // A second bar stacked on the first: touching end to end passes; moved down by one lattice

@@ -629,6 +629,51 @@ double nose_length(const NoseSpec& nose, double radius) {
     return 0.0;
 }
 
+std::vector<std::string> scene_warnings(const Scene& scene) {
+    std::vector<std::string> out;
+    const int dim = dimension_of(scene.geometry);
+    const auto length_text = [](double m) {
+        return m >= 1.0 ? fmt::format("{:.4g} m", m) : m >= 1e-3 ? fmt::format("{:.4g} mm", m * 1e3) : fmt::format("{:.4g} um", m * 1e6);
+    };
+    for (std::size_t k = 0; k < scene.bodies.size(); ++k) {
+        const BodySpec& b = scene.bodies[k];
+        const std::string label = fmt::format("body \"{}\" (body[{}])", b.name, k);
+        double speed = 0.0;
+        for (int c = 0; c < dim; ++c) speed += b.velocity[static_cast<std::size_t>(c)] * b.velocity[static_cast<std::size_t>(c)];
+        speed = std::sqrt(speed);
+        if (speed > 20e3) {
+            out.push_back(fmt::format("{}: a speed of {:.4g} km/s is beyond any impact experiment (light-gas guns reach about 10 "
+                                      "km/s, orbital debris 15 km/s): check its unit (m/s, km/s, mm/us)",
+                                      label, speed * 1e-3));
+        }
+        // The body's extents: the smallest and the largest.
+        double smallest = INFINITY, largest = 0.0;
+        const auto extent = [&](double e) {
+            smallest = std::min(smallest, e);
+            largest = std::max(largest, e);
+        };
+        if (is_round(b.shape)) {
+            extent(2.0 * b.radius);
+            if (b.shape != ShapeKind::Sphere) extent(b.length);
+        } else {
+            for (int c = 0; c < dim; ++c) extent(b.size[static_cast<std::size_t>(c)]);
+        }
+        if (smallest < 10e-6) {
+            out.push_back(fmt::format("{}: it is {} across, smaller than any impact specimen or projectile: check the units "
+                                      "of its size (m, mm, um)", label, length_text(smallest)));
+        }
+        if (largest > 10.0) {
+            out.push_back(fmt::format("{}: it is {} across, larger than any impact specimen or target: check the units of its "
+                                      "size (m, mm, um)", label, length_text(largest)));
+        }
+    }
+    if (scene.stop.end_time > 0.1) {
+        out.push_back(fmt::format("stop.end_time: {:.4g} s; impacts last micro- to milliseconds and a step is a fraction of the "
+                                  "time sound takes across a node: check its unit (s, ms, us)", scene.stop.end_time));
+    }
+    return out;
+}
+
 double cylinder_radius_at(const BodySpec& b, double height) {
     if (!(height >= 0.0 && height <= b.length)) return 0.0;
     if (!b.nose) return b.radius;

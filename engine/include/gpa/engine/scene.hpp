@@ -299,4 +299,12 @@ private:
 
 void validate_scene(const Scene& scene);
 
+// Values a valid scene may hold but an impact simulation hardly ever does, most often a unit
+// slip ("190 km/s" for 190 m/s, "10 m" for 10 mm): a body faster than 20 km/s (light-gas guns
+// reach about 10 km/s, orbital debris 15 km/s), a body smaller than 10 um or larger than 10 m
+// across, an end time beyond 0.1 s (impacts last micro- to milliseconds). One message per finding,
+// naming the body or key, its value and what to check; empty when nothing is odd. They are
+// warnings (gpa check and gpa run print them), never refusals: such a scene may be meant.
+std::vector<std::string> scene_warnings(const Scene& scene);
+
 }  // namespace gpa
