@@ -12,6 +12,7 @@
 
 #include <Eigen/Dense>
 #include <gtest/gtest.h>
+#include <tbb/global_control.h>
 
 #include "gpa/engine/bodies.hpp"
 #include "gpa/engine/element_kernels.hpp"
@@ -19,6 +20,7 @@
 #include "gpa/engine/errors.hpp"
 #include "gpa/engine/measure.hpp"
 #include "gpa/engine/simulation.hpp"
+#include "gpa/io/material_library.hpp"
 #include "gpa/io/study.hpp"
 #include "support/scenes.hpp"
 
@@ -802,6 +804,53 @@ TEST(Measurement, ParticlesReachHalfADiameterBeyondTheirCentresElementNodesLieOn
     EXPECT_DOUBLE_EQ(plane_strain.footprint(), 4e-3);
     EXPECT_EQ(measure::Extent{}.length(), 0.0);
     EXPECT_EQ(measure::Extent{}.footprint(), 0.0);
+}
+
+}  // namespace
+}  // namespace gpa
+
+namespace gpa {
+namespace {
+
+// The element stress phase's fault path (materials::PointModel, no exception per point): a copper
+// block (Mie-Grueneisen) squeezed to a third of its area in one step passes its equation of
+// state's guard (mu = 2 beyond the Hugoniot pole's 1.84) at every point, the mesh itself still
+// sound. The step stops with a NumericalError that names the first point (element 0, triangle 0),
+// the body, the material and the equation of state's own words, on 1 and 2 threads alike, and
+// leaves every point's state as it was.
+TEST(ElementStressPhase, APointBeyondItsEquationOfStateStopsTheStepNamingIt) {
+    for (const int threads : {1, 2}) {
+        tbb::global_control limit(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads));
+        Scene s = element_block(GeometryKind::PlaneStrain, 0.0, 4e-3, 4e-3, 0.5e-3);
+        s.materials[0] = io::builtin_material("OFHC copper");
+        s.bodies[0].material = "OFHC copper";
+        ElementMesh m = mesh_element_bodies(s);
+        const double dt = 1e-8;
+        const double k = (1.0 - 1.0 / std::sqrt(3.0)) / dt;  // x -> (1 - k dt) x: the area / 3
+        for (std::size_t i = 0; i < m.nodes.size(); ++i) {
+            m.nodes.velocity[0][i] = -k * m.nodes.position[0][i];
+            m.nodes.velocity[1][i] = -k * m.nodes.position[1][i];
+        }
+        ElementPart part(s, m, ElementOptions{});
+        const ElementPoints before = part.mesh().points;
+        part.move(dt);
+        try {
+            part.update_stress(dt, 1, dt);
+            FAIL() << "the step must stop at the points beyond the equation of state's guard";
+        } catch (const NumericalError& e) {
+            const std::string what = e.what();
+            EXPECT_NE(what.find("element 0 (triangle 0 of its four) of body \"block\""), std::string::npos) << threads << ": " << what;
+            EXPECT_NE(what.find("material \"OFHC copper\""), std::string::npos) << what;
+            EXPECT_NE(what.find("Hugoniot pole"), std::string::npos) << what;
+        }
+        const ElementPoints& after = part.mesh().points;
+        for (std::size_t i = 0; i < after.size(); ++i) {
+            ASSERT_EQ(after.pressure[i], before.pressure[i]) << "point " << i;
+            ASSERT_EQ(after.density[i], before.density[i]) << "point " << i;
+            ASSERT_EQ(after.internal_energy[i], before.internal_energy[i]) << "point " << i;
+            ASSERT_EQ(after.deviatoric_stress[0][i], before.deviatoric_stress[0][i]) << "point " << i;
+        }
+    }
 }
 
 }  // namespace

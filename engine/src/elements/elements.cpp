@@ -21,6 +21,7 @@
 #include "gpa/engine/kernels.hpp"
 #include "gpa/engine/measure.hpp"
 #include "gpa/engine/stress.hpp"
+#include "reduce_grain.hpp"
 
 namespace gpa {
 
@@ -28,7 +29,6 @@ using element::Vec2;
 
 namespace {
 
-constexpr std::size_t reduce_grain = 4096;  // fixed, so that every sum has one order on any thread count
 constexpr std::size_t quad_grain = 256;
 constexpr NodeIndex no_node = std::numeric_limits<NodeIndex>::max();
 constexpr std::size_t max_planes = 8;  // ElementNodes::held and ::contact are bit masks of 8 planes

@@ -6,11 +6,11 @@
 
 #include "gpa/engine/drivers.hpp"
 #include "gpa/engine/geometry.hpp"
+#include "reduce_grain.hpp"
 
 namespace gpa {
 
 namespace {
-constexpr std::size_t reduce_grain = 4096;  // fixed, so that every sum has one order on any thread count
 
 double* zeroed(std::vector<double>& v, std::size_t count) {
     v.assign(count, 0.0);

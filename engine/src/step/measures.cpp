@@ -7,11 +7,9 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_reduce.h>
 
-namespace gpa {
+#include "reduce_grain.hpp"
 
-namespace {
-constexpr std::size_t reduce_grain = 4096;  // fixed, so that every sum has one order on any thread count
-}  // namespace
+namespace gpa {
 
 NodeSums& NodeSums::operator+=(const NodeSums& o) {
     kinetic += o.kinetic;

@@ -10,12 +10,12 @@
 
 #include "gpa/engine/errors.hpp"
 #include "step/contact.hpp"
+#include "reduce_grain.hpp"
 
 namespace gpa {
 
 namespace {
 
-constexpr std::size_t reduce_grain = 4096;  // fixed, so that every sum has one order on any thread count
 
 PositionView positions_of(const NodeStore& n) {
     PositionView v;

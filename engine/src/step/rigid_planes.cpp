@@ -7,10 +7,11 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_reduce.h>
 
+#include "reduce_grain.hpp"
+
 namespace gpa {
 namespace {
 
-constexpr std::size_t reduce_grain = 4096;  // fixed, so that every sum has one order on any thread count
 
 }  // namespace
 

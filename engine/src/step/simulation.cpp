@@ -39,12 +39,12 @@
 #include "step/rigid_planes.hpp"
 #include "step/run_control.hpp"
 #include "step/switching.hpp"
+#include "reduce_grain.hpp"
 
 namespace gpa {
 
 namespace {
 
-constexpr std::size_t reduce_grain = 4096;  // fixed, so that every sum has one order on any thread count
 
 }  // namespace
 
