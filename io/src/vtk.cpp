@@ -70,6 +70,8 @@ void write_vtp(const std::filesystem::path& path, const NodeStore& nodes, std::s
     std::vector<std::uint64_t> offsets;
     for (const auto& a : arrays) offsets.push_back(data.add_float(count, a.components, a.value));
     const std::uint64_t points = data.add_float(count, 3, positions);
+    // The node ids (node_store.hpp): the same node in every snapshot, whatever the run's reordering.
+    const std::uint64_t ids = data.add_int64(count, [&](std::size_t i) { return static_cast<std::int64_t>(nodes.id[i]); });
     const std::uint64_t connectivity = data.add_int64(count, [](std::size_t i) { return static_cast<std::int64_t>(i); });
     const std::uint64_t vertex_ends = data.add_int64(count, [](std::size_t i) { return static_cast<std::int64_t>(i + 1); });
 
@@ -83,6 +85,8 @@ void write_vtp(const std::filesystem::path& path, const NodeStore& nodes, std::s
             out << fmt::format("        <DataArray type=\"Float64\" Name=\"{}\" NumberOfComponents=\"{}\" format=\"appended\" offset=\"{}\"/>\n",
                                arrays[k].name, arrays[k].components, offsets[k]);
         }
+        out << fmt::format("        <DataArray type=\"Int64\" Name=\"id\" NumberOfComponents=\"1\" format=\"appended\" offset=\"{}\"/>\n",
+                           ids);
         out << "      </PointData>\n      <Points>\n";
         out << fmt::format("        <DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"appended\" offset=\"{}\"/>\n", points);
         out << "      </Points>\n      <Verts>\n";

@@ -4,6 +4,8 @@
 // guards (a size limit however the file is opened, non-ASCII text only where TOML allows it).
 
 #include <algorithm>
+#include <cmath>
+#include <numeric>
 #include <csignal>
 #include <filesystem>
 #include <fstream>
@@ -19,6 +21,7 @@
 #include "gpa/io/folder_lock.hpp"
 #include "gpa/io/output.hpp"
 #include "gpa/io/scene_file.hpp"
+#include "gpa/io/snapshot_reader.hpp"
 
 namespace gpa::io {
 namespace {
@@ -206,6 +209,71 @@ TEST(Snapshots, OnesOutsideTheScheduleAreMarkedInThePvd) {
     EXPECT_NE(pvd.find(R"(file="particles_00001.vtp"/>)"), std::string::npos) << "the schedule's numbering goes on: " << pvd;
     EXPECT_EQ(series.scheduled(), 2u);
     EXPECT_EQ(series.count(), 3u);
+    fs::remove_all(dir);
+}
+
+// Node ids (NodeStore::id, issue 24): a run that reorders its nodes every 5 steps writes, in every
+// snapshot, the id of each node; read back by id, every node is there in every snapshot, moves
+// between two snapshots no further than the fastest node could (so it is the same material point),
+// starts where the lattice put it, and ends where the engine has the node of that id.
+TEST(Snapshots, EveryNodeCanBeFollowedByItsIdThroughAReorderingRun) {
+    const fs::path dir = scratch("ids");
+    std::string text = tiny_scene;
+    text.replace(text.find("max_steps = 20"), 14, "max_steps = 60\n[solver]\nreorder_interval = 5");
+    const Scene scene = parse_scene(text, "tiny.toml");
+    Simulation sim(scene, 2);
+    const std::size_t n = sim.real_count();
+    std::vector<std::array<double, 2>> start(n);
+    for (std::size_t i = 0; i < n; ++i) start[sim.nodes().id[i]] = {sim.nodes().position[0][i], sim.nodes().position[1][i]};
+    SnapshotSeries series(dir);
+    std::vector<double> times{sim.time()};
+    series.write(sim.nodes(), n, sim.time());
+    double fastest = 0.0;
+    for (int k = 0; k < 6; ++k) {
+        for (int s2 = 0; s2 < 10; ++s2) {
+            sim.step();
+            for (std::size_t i = 0; i < n; ++i) fastest = std::max(fastest, std::hypot(sim.nodes().velocity[0][i], sim.nodes().velocity[1][i]));
+        }
+        series.write(sim.nodes(), n, sim.time());
+        times.push_back(sim.time());
+    }
+    const SnapshotIndex index = read_pvd(dir / "particles.pvd");
+    ASSERT_EQ(index.snapshots.size(), times.size());
+    std::vector<std::array<double, 2>> previous;
+    bool reordered = false;
+    for (std::size_t k = 0; k < index.snapshots.size(); ++k) {
+        const VtkFile file(index.snapshots[k].files.at(0));
+        const std::vector<double> ids = file.values("id", DataLocation::Point);
+        const std::vector<double> points = file.points();
+        ASSERT_EQ(ids.size(), n);
+        std::vector<std::array<double, 2>> by_id(n, {NAN, NAN});
+        for (std::size_t i = 0; i < n; ++i) {
+            const auto id = static_cast<std::size_t>(ids[i]);
+            ASSERT_LT(id, n);
+            ASSERT_TRUE(std::isnan(by_id[id][0])) << "id " << id << " twice in snapshot " << k;
+            by_id[id] = {points[3 * i], points[3 * i + 1]};
+            reordered |= id != i;
+        }
+        if (k == 0) {
+            for (std::size_t id = 0; id < n; ++id) {
+                EXPECT_EQ(by_id[id][0], start[id][0]);
+                EXPECT_EQ(by_id[id][1], start[id][1]);
+            }
+        } else {
+            // No node moves further than the fastest speed over the interval (1 % for the leapfrog's
+            // half-step velocities).
+            const double reach = 1.01 * fastest * (times[k] - times[k - 1]);
+            for (std::size_t id = 0; id < n; ++id) {
+                ASSERT_LE(std::hypot(by_id[id][0] - previous[id][0], by_id[id][1] - previous[id][1]), reach) << "id " << id;
+            }
+        }
+        previous = by_id;
+    }
+    EXPECT_TRUE(reordered) << "the run reordered its nodes: the test follows them";
+    for (std::size_t i = 0; i < n; ++i) {
+        EXPECT_EQ(previous[sim.nodes().id[i]][0], sim.nodes().position[0][i]);
+        EXPECT_EQ(previous[sim.nodes().id[i]][1], sim.nodes().position[1][i]);
+    }
     fs::remove_all(dir);
 }
 

@@ -192,6 +192,7 @@ void GhostSet::update(NodeStore& nodes, std::size_t real_count) const {
             nodes.initial_diameter[g] = nodes.initial_diameter[s];
             nodes.connectivity[g] = nodes.connectivity[s];
             nodes.body[g] = nodes.body[s];
+            nodes.id[g] = nodes.id[s];
             nodes.material[g] = nodes.material[s];
             nodes.failed[g] = nodes.failed[s];
         }

@@ -133,6 +133,7 @@ std::size_t fill_lattice(NodeStore& nodes, const LatticeBlock& block) {
         nodes.initial_diameter[i] = d0;
         nodes.diameter[i] = d0;
         nodes.body[i] = block.body;
+        nodes.id[i] = static_cast<std::uint32_t>(i);  // the fill order (node_store.hpp)
         nodes.material[i] = block.material;
         nodes.connectivity[i] = block.connectivity;
         index_of.emplace(cells[k], static_cast<NodeIndex>(i));

@@ -63,6 +63,7 @@ void NodeStore::for_each_field(F&& f) {
     f("stable_length", stable_length);
     f("body", body);
     f("material", material);
+    f("id", id);
     f("connectivity", connectivity);
     f("volumetric_strain_rate", volumetric_strain_rate);
     f("smallest_h", smallest_h);

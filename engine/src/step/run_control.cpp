@@ -60,7 +60,7 @@ std::optional<std::pair<std::size_t, std::string>> first_non_finite(const NodeSt
 std::string describe_site(const FailureSite& f) {
     std::string text = fmt::format("step {} at t = {:.6g} us, phase \"{}\"", f.step, f.time * 1e6, f.phase);
     if (f.node) {
-        text += fmt::format(": node {}", *f.node);
+        text += f.id ? fmt::format(": node id {} (index {})", *f.id, *f.node) : fmt::format(": node {}", *f.node);
         if (!f.body.empty()) text += fmt::format(" of body \"{}\"", f.body);
         text += " at (";
         for (int c = 0; c < f.dim; ++c) text += fmt::format("{}{:.6g}", c ? ", " : "", f.position[c] * 1e3);
@@ -123,6 +123,7 @@ StepFailure RunControl::step_failure(const std::exception& e, const std::string&
         const std::size_t i = *site.node;
         const auto b = static_cast<std::size_t>(nodes.body[i]);
         if (b < scene.bodies.size()) site.body = scene.bodies[b].name;
+        if (i < nodes.id.size()) site.id = nodes.id[i];
         for (int c = 0; c < nodes.dim(); ++c) site.position[c] = nodes.position[c][i];
     }
     return StepFailure(describe_site(site), site);
@@ -132,7 +133,7 @@ void RunControl::check_step(double time_before, double time, double dt_half, std
                             const NodeStore& nodes, std::size_t real) const {
     const Scene& scene = *scene_;
     if (!(time > time_before)) {
-        FailureSite site{steps, time, "move", {}, {}, {0, 0, 0}, nodes.dim(), "time", {}};
+        FailureSite site{steps, time, "move", {}, {}, {}, {0, 0, 0}, nodes.dim(), "time", {}};
         site.cause = fmt::format("the time step {:.3g} s no longer advances the time (it is below the rounding step of "
                                  "t = {:.6g} s); a time loop would never end",
                                  dt_half, time);
@@ -153,8 +154,9 @@ void RunControl::check_step(double time_before, double time, double dt_half, std
                 if (std::isnan(v2)) break;
             }
         }
-        FailureSite site{steps, time, "totals", fastest, {}, {0, 0, 0}, nodes.dim(), "total energy", {}};
+        FailureSite site{steps, time, "totals", fastest, {}, {}, {0, 0, 0}, nodes.dim(), "total energy", {}};
         if (real > 0) {
+            site.id = nodes.id[fastest];
             const auto b = static_cast<std::size_t>(nodes.body[fastest]);
             if (b < scene.bodies.size()) site.body = scene.bodies[b].name;
             for (int c = 0; c < nodes.dim(); ++c) site.position[c] = nodes.position[c][fastest];

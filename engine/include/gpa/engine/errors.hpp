@@ -46,7 +46,8 @@ struct FailureSite {
     std::size_t step = 0;
     double time = 0.0;
     std::string phase;
-    std::optional<std::size_t> node;
+    std::optional<std::size_t> node;   // its index in the node arrays at the time
+    std::optional<std::size_t> id;     // its id (NodeStore::id: stable through the run)
     std::string body;
     std::array<double, 3> position{0, 0, 0};
     int dim = 2;

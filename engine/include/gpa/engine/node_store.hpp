@@ -74,6 +74,10 @@ public:
     std::vector<std::uint8_t> velocity_region;     // 0: free; k + 1: held by Scene::prescribed_velocities[k] (prescribed.hpp)
     std::vector<std::int32_t> body;
     std::vector<std::int32_t> material;
+    // The node's id: its place in the order the scene's particle bodies were filled (bodies in scene
+    // order, each in lattice order: fill_lattice), kept through every reordering, so that outputs and
+    // messages can name a node for the whole run. A ghost carries its source's id.
+    std::vector<std::uint32_t> id;
     std::vector<Connectivity> connectivity;
 
     // --- results of the gradient and force phases, rewritten every step ------------------
