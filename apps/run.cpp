@@ -66,10 +66,13 @@ SceneSource read_source(const std::optional<fs::path>& file) {
 }
 
 // Scheduled snapshot times: t_k = k * interval for whole k, from `snapshot_interval`, or from
-// `snapshots` spread over the end time; with neither known, the first and the last only. A step
-// writes one when it passes a t_k; which t_k it has reached is computed from its time (a whole
-// number, floor(t / interval)), never by adding the interval up, so that an interval below the
-// rounding step of the time cannot stall the schedule (at most one snapshot per step).
+// `snapshots` spread over the end time; with neither known, the first and the last only. The
+// snapshot of t_k is the state of the step nearest to it (its own time is written with it): a step
+// at t writes the next t_k when the step after it, at t + dt_next, would be further from t_k, that
+// is when t + dt_next / 2 has passed t_k (the steps are not shortened to land on t_k: the run is the
+// same whatever its output schedule). Which t_k that is is computed from the time (a whole number,
+// floor(t / interval)), never by adding the interval up, so that an interval below the rounding step
+// of the time cannot stall the schedule (at most one snapshot per step).
 class SnapshotSchedule {
 public:
     explicit SnapshotSchedule(const Scene& s) {
@@ -82,10 +85,11 @@ public:
     double interval() const { return interval_; }
     // The last t_k at or before t (with a relative 1e-9 for a step that lands on t_k).
     double slot(double t) const { return interval_ > 0.0 ? std::floor(t / interval_ * (1.0 + 1e-9)) : 0.0; }
-    // True (and remembered) when t has passed a scheduled time since the last snapshot.
-    bool due(double t) {
+    // True (and remembered) when the step at t is the nearest to a scheduled time not yet written:
+    // t + dt_next / 2 has passed it (dt_next: the step that would follow).
+    bool due(double t, double dt_next) {
         if (!(interval_ > 0.0)) return false;
-        const double k = slot(t);
+        const double k = slot(t + 0.5 * dt_next);
         if (!(k > last_)) return false;
         last_ = k;
         return true;
@@ -421,7 +425,7 @@ public:
                 }
                 const bool last = sim_.finished();
                 if (last || sim_.steps() % every == 0) write_row();
-                if (schedule_.due(sim_.time()) || last) snapshots_.write(sim_);
+                if (schedule_.due(sim_.time(), sim_.next_time_step()) || last) snapshots_.write(sim_);
                 const auto now = std::chrono::steady_clock::now();
                 const bool by_steps = scene.output.checkpoint_every_steps > 0 && sim_.steps() % scene.output.checkpoint_every_steps == 0;
                 const bool by_time = scene.output.checkpoint_every_seconds > 0.0 &&

@@ -63,6 +63,17 @@ expect 0 "overwrite" -- "$gpa" run "$src/tests/cli/tiny.toml" -o keep --overwrit
 [[ -e keep/result.txt ]] && fail "--overwrite kept the old contents"
 [[ -s keep/summary.json ]] || fail "--overwrite run has no summary"
 
+# 4b. Snapshots at the scheduled times: each is the step nearest to k x interval, within half a
+#     step of it (the steps of this bar are about 15 ns; the interval, 50 ns, is no multiple).
+sed 's/^snapshots = 3/snapshot_interval = "50 ns"/' "$src/tests/cli/tiny.toml" > timed.toml
+expect 0 "timed snapshots" -- "$gpa" run timed.toml -o timed -q
+largest_dt=$(awk -F, 'NR > 1 && $2 > m { m = $2 } END { print m }' timed/history.csv)
+grep -o 'timestep="[^"]*"' timed/particles.pvd | sed 's/timestep="\(.*\)"/\1/' |
+  awk -v dt="$largest_dt" -v interval=50e-9 'NR > 1 {
+      k = int($1 / interval + 0.5); off = $1 - k * interval; if (off < 0) off = -off
+      if (off > 0.5 * dt * (1 + 1e-9)) { print "snapshot at " $1 " s is " off " s from " k * interval " s (half a step: " 0.5 * dt ")"; bad = 1 }
+    } END { exit bad }' > timed.txt || fail "snapshots not at the nearest step: $(cat timed.txt)"
+
 # 5. The library listing and a good check.
 expect 0 "materials" -- "$gpa" materials
 for m in "OFHC copper" "Armco iron" "4340 steel" "2024-T351"; do grep -q "$m" out.txt || fail "materials lacks $m"; done
