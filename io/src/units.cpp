@@ -146,6 +146,7 @@ struct Base {
     int decimal_exponent = 0;
     double factor = 1.0;
     bool prefixed = false;  // takes an SI prefix (mm, kg, MPa, kbar)
+    bool plural = false;    // a word that may also end in s (seconds, metres)
 };
 
 constexpr Exponents length_e{1, 0, 0, 0}, mass_e{0, 1, 0, 0}, time_e{0, 0, 1, 0}, temperature_e{0, 0, 0, 1};
@@ -169,27 +170,17 @@ constexpr std::array bases{
     Base{"lbf", force_e, 0, pound_force},
     Base{"psi", pressure_e, 0, psi},
     Base{"ksi", pressure_e, 3, psi},
-    // Words, for those who spell units out.
-    Base{"second", time_e},
-    Base{"seconds", time_e},
-    Base{"millisecond", time_e, -3},
-    Base{"milliseconds", time_e, -3},
-    Base{"microsecond", time_e, -6},
-    Base{"microseconds", time_e, -6},
-    Base{"nanosecond", time_e, -9},
-    Base{"nanoseconds", time_e, -9},
-    Base{"minute", time_e, 0, 60.0},
-    Base{"minutes", time_e, 0, 60.0},
-    Base{"hour", time_e, 0, 3600.0},
-    Base{"hours", time_e, 0, 3600.0},
-    Base{"metre", length_e},
-    Base{"metres", length_e},
-    Base{"meter", length_e},
-    Base{"meters", length_e},
-    Base{"millimetre", length_e, -3},
-    Base{"millimetres", length_e, -3},
-    Base{"millimeter", length_e, -3},
-    Base{"millimeters", length_e, -3},
+    // Words, for those who spell units out (each also with a plural s: base_unit).
+    Base{"second", time_e, 0, 1.0, false, true},
+    Base{"millisecond", time_e, -3, 1.0, false, true},
+    Base{"microsecond", time_e, -6, 1.0, false, true},
+    Base{"nanosecond", time_e, -9, 1.0, false, true},
+    Base{"minute", time_e, 0, 60.0, false, true},
+    Base{"hour", time_e, 0, 3600.0, false, true},
+    Base{"metre", length_e, 0, 1.0, false, true},
+    Base{"meter", length_e, 0, 1.0, false, true},
+    Base{"millimetre", length_e, -3, 1.0, false, true},
+    Base{"millimeter", length_e, -3, 1.0, false, true},
     Base{"inch", length_e, 0, 0.0254},
     Base{"inches", length_e, 0, 0.0254},
     Base{"foot", length_e, 0, 0.3048},
@@ -250,7 +241,10 @@ std::string describe(const Exponents& e) {
 
 std::optional<Conversion> base_unit(std::string_view word) {
     for (const Base& b : bases) {
-        if (b.symbol == word) return Conversion{b.exponents, b.decimal_exponent, b.factor};
+        if (b.symbol == word || (b.plural && word.size() == b.symbol.size() + 1 && word.back() == 's' &&
+                                 word.substr(0, b.symbol.size()) == b.symbol)) {
+            return Conversion{b.exponents, b.decimal_exponent, b.factor};
+        }
     }
     if (word.size() < 2) return std::nullopt;
     for (const Prefix& p : prefixes) {
