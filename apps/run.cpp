@@ -57,7 +57,6 @@ constexpr const char* builtin_label = "(built-in default)";  // the summary's sc
 // default_scene_file) and says, whatever --quiet, when one is not there (io::resolve_scene_files).
 void resolve_files(Scene& scene, const fs::path& scene_file) {
     if (const std::string warning = io::resolve_scene_files(scene, scene_file); !warning.empty()) spdlog::warn("{}", warning);
-    for (const std::string& odd : scene_warnings(scene)) spdlog::warn("{}: {}", scene_file.string(), odd);
 }
 
 SceneSource read_source(const std::optional<fs::path>& file) {
@@ -580,6 +579,7 @@ int fresh_run(const RunOptions& options) {
     SceneSource source = read_source(options.scene);
     Scene scene = io::parse_scene(source.text, source.name);
     resolve_files(scene, options.scene ? *options.scene : default_scene_file);
+    log_scene_warnings(scene, source.name);
     const fs::path output = options.output.value_or(default_output_folder("runs", scene.name));
     Simulation sim(scene, options.threads, options.memory);  // before the folder: an impossible scene leaves nothing behind
     io::RunFolder folder(output, options.overwrite);
@@ -675,7 +675,7 @@ int check_scene(const fs::path& file, const MemoryLimit& memory) {
     const Scene scene = io::load_scene(file, &warning);
     // Implausible values first: a unit slip in a size may make the set-up below refuse the scene
     // for its memory, and the user should see why.
-    for (const std::string& odd : scene_warnings(scene)) spdlog::warn("{}: {}", file.string(), odd);
+    log_scene_warnings(scene, file.string());
     Simulation sim(scene, 1, memory);  // builds the nodes: every check of set-up runs
     fmt::print("{}: OK\n", file.string());
     fmt::print("  {} ({}), {} bod{}, {} real nodes, {} ghost nodes at the start\n", scene.name, name_of(scene.geometry),
@@ -732,8 +732,10 @@ std::string eos_summary(const materials::EquationOfState& eos) {
     if (const auto* poly = std::get_if<materials::PolynomialEos>(&eos)) {
         return fmt::format("polynomial EOS K1 {:.4g} GPa, Gamma0 {}", poly->k1 / 1e9, poly->gruneisen);
     }
-    const auto& mg = std::get<materials::MieGruneisenEos>(eos);
-    return fmt::format("Mie-Grueneisen EOS c0 {} m/s, s {}, Gamma0 {}", mg.sound_speed, mg.slope, mg.gruneisen);
+    if (const auto* mg = std::get_if<materials::MieGruneisenEos>(&eos)) {
+        return fmt::format("Mie-Grueneisen EOS c0 {} m/s, s {}, Gamma0 {}", mg->sound_speed, mg->slope, mg->gruneisen);
+    }
+    return "an equation of state";
 }
 
 std::string failure_summary(const materials::Failure& f) {
@@ -747,6 +749,10 @@ std::string failure_summary(const materials::Failure& f) {
 }
 
 }  // namespace
+
+void log_scene_warnings(const Scene& scene, std::string_view label) {
+    for (const std::string& odd : scene_warnings(scene)) spdlog::warn("{}: {}", label, odd);
+}
 
 int list_materials(const std::vector<std::string>& names) {
     if (!names.empty()) {

@@ -10,6 +10,8 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <string_view>
+#include <vector>
 
 #include "gpa/engine/limits.hpp"
 
@@ -38,5 +40,9 @@ int check_scene(const std::filesystem::path& scene, const MemoryLimit& memory = 
 // `gpa materials`: one paragraph per built-in material; with names, every constant of each as a
 // [[material]] table (io::material_as_toml). An unknown name is an InputError listing the library.
 int list_materials(const std::vector<std::string>& names);
+
+// Logs a scene's implausible values (gpa::scene_warnings), each prefixed with `label` (the scene
+// file), before its set-up: gpa run, check and study.
+void log_scene_warnings(const Scene& scene, std::string_view label);
 
 }  // namespace gpa::app

@@ -158,7 +158,7 @@ int run_study(const StudyOptions& options) {
     std::string reference_warning;
     const Scene scene = io::load_scene(options.scene, &reference_warning);
     if (!reference_warning.empty()) spdlog::warn("{}", reference_warning);
-    for (const std::string& odd : scene_warnings(scene)) spdlog::warn("{}: {}", options.scene.string(), odd);
+    log_scene_warnings(scene, options.scene.string());
     const std::vector<double> factors = io::parse_refinements(options.refine);
     const std::vector<int> thread_counts = io::parse_thread_counts(options.threads);
     std::vector<io::Variant> variants;

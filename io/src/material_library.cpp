@@ -86,6 +86,8 @@ std::string toml_string(std::string_view text) {
 // so moving the decimal point here changes nothing): 9e7 in MPa is "90", 7.519e10 in GPa "75.19".
 std::string decimal_in(double si, int unit_exponent) {
     if (!std::isfinite(si)) return fmt::format("{}", si);  // "inf": only where a key accepts it
+    // Zero in any unit is 0; -0.0 keeps its sign and reads as a float where TOML takes it plain.
+    if (si == 0.0) return std::signbit(si) ? "-0.0" : "0";
     char buffer[64];
     const auto [end, ec] = std::to_chars(buffer, buffer + sizeof buffer, si, std::chars_format::scientific);
     if (ec != std::errc{}) return fmt::format("{}e{}", si, -unit_exponent);

@@ -354,13 +354,17 @@ bool equal_ignoring_case(std::string_view a, std::string_view b) {
     return true;
 }
 
-// A unit of `d` spelt like `written` but for letter case ("MM" for "mm"), if there is one.
-const Unit* case_insensitive_match(std::string_view written, Dimension d) {
+// A listed unit spelt like `written` but for letter case ("MM" for "mm"), if there is one: of
+// dimension d when there is such, else of any dimension (d nullopt: any).
+const Unit* case_insensitive_match(std::string_view written, std::optional<Dimension> d) {
     const std::string key = canonical(written);
+    const Unit* other = nullptr;
     for (const Unit& u : units) {
-        if (u.dimension == d && equal_ignoring_case(canonical(u.symbol), key)) return &u;
+        if (!equal_ignoring_case(canonical(u.symbol), key)) continue;
+        if (!d || u.dimension == *d) return &u;
+        if (!other) other = &u;
     }
-    return nullptr;
+    return other;
 }
 
 // A number as written: its digits with an optional sign and decimal point, and its exponent.
@@ -416,7 +420,7 @@ std::string_view trim(std::string_view s) {
 }
 
 constexpr std::string_view compound_hint =
-    ", or a compound of m, g, s, K, Pa, N, J, bar (with the prefixes n, u, m, c, k, M, G), cc, min, h, in, ft, "
+    ", or a compound of m, g, s, Pa, N, J, bar (with the prefixes n, u, m, c, k, M, G), K, cc, min, h, in, ft, "
     "lb, lbf, psi, ksi and powers (\"mm/ms\", \"GN/m^2\", \"lbf/in^2\")";
 
 std::string article_name(Dimension d) {
@@ -459,8 +463,12 @@ double to_double(const WrittenNumber& n, const Conversion* unit, std::string_vie
         throw UnitError(fmt::format("\"{}\" is not a number with a unit (write e.g. \"15.2 mm\")", text));
     }
     if (unit && unit->factor != 1.0) {
+        const double written = value;
         value *= unit->factor;
-        if (!std::isfinite(value)) throw UnitError(fmt::format("\"{}\" is outside the range of a double", text));
+        // Infinite, or a number that is not zero become zero or subnormal (as the decimal units refuse it).
+        if (!std::isfinite(value) || (written != 0.0 && !std::isnormal(value))) {
+            throw UnitError(fmt::format("\"{}\" is outside the range of a double", text));
+        }
     }
     return value;
 }
@@ -517,9 +525,16 @@ namespace {
 
 Conversion conversion_of(const Unit& u) { return {exponents_of(u.dimension), u.decimal_exponent, u.factor}; }
 
-// A listed unit, else a compound one; nullopt when neither reads the text.
-std::optional<Conversion> read_unit(std::string_view written) {
+// A listed unit, else a compound one; nullopt when neither reads the text. A unit that is a listed
+// one but for letter case is refused with the listed spelling, even where it would read as a
+// compound: "mPa", "mbar", "Mm" and "Ms" are milli-pascal, millibar, megametre and megasecond,
+// but in a scene of impacts they are MPa, Mbar, mm and ms mistyped.
+std::optional<Conversion> read_unit(std::string_view written, std::string_view text, std::optional<Dimension> expected) {
     if (const Unit* listed = find_unit(written)) return conversion_of(*listed);
+    if (const Unit* near = case_insensitive_match(written, expected)) {
+        throw UnitError(fmt::format("unknown unit \"{}\" in \"{}\" (units are case-sensitive: did you mean \"{}\"?)", written,
+                                    text, near->symbol));
+    }
     return compound_unit(written);
 }
 
@@ -532,12 +547,8 @@ double parse_quantity(std::string_view text, Dimension expected) {
         throw UnitError(fmt::format("\"{}\" has no unit: write {} as a plain number in {} or as a string with one of {}",
                                     text, article_name(expected), si_unit_of(expected), accepted_units(expected)));
     }
-    const auto unit = read_unit(s.unit);
+    const auto unit = read_unit(s.unit, text, expected);
     if (!unit) {
-        if (const Unit* near = case_insensitive_match(s.unit, expected)) {
-            throw UnitError(fmt::format("unknown unit \"{}\" in \"{}\" (units are case-sensitive: did you mean \"{}\"?)",
-                                        s.unit, text, near->symbol));
-        }
         throw UnitError(fmt::format("unknown unit \"{}\" in \"{}\"; {}", s.unit, text, takes(expected)));
     }
     const auto dimension = dimension_of(unit->exponents);
@@ -555,7 +566,7 @@ double parse_quantity(std::string_view text, Dimension expected) {
 Quantity parse_any_quantity(std::string_view text) {
     const Split s = split(text);
     if (s.unit.empty()) return {to_double(s.number, nullptr, text), Dimension::Dimensionless};
-    const auto unit = read_unit(s.unit);
+    const auto unit = read_unit(s.unit, text, std::nullopt);
     const auto dimension = unit ? dimension_of(unit->exponents) : std::nullopt;
     if (!dimension) {
         std::string all;
@@ -575,7 +586,11 @@ std::optional<Quantity> compound_unit_value(std::string_view unit) {
     if (!c) return std::nullopt;
     const auto dimension = dimension_of(c->exponents);
     if (!dimension) return std::nullopt;
-    return Quantity{to_double(WrittenNumber{"1", 0, 1}, &*c, unit), *dimension};
+    try {
+        return Quantity{to_double(WrittenNumber{"1", 0, 1}, &*c, unit), *dimension};
+    } catch (const UnitError&) {
+        return std::nullopt;  // one such unit is beyond the range of a double ("Gm^9.Gm^9/nm^9/nm^9")
+    }
 }
 
 }  // namespace gpa::io

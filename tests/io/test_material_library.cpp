@@ -230,7 +230,7 @@ TEST(MaterialLibrary, EveryMaterialPrintsAsATableThatReadsBackBitForBit) {
     m::Material poly = odd;
     poly.name = "polynomial";
     poly.melt_temperature = 1e4 / 7.0;
-    poly.eos = m::PolynomialEos{165e9, -1.23456789e11, 9.87654321e12, 1.7};
+    poly.eos = m::PolynomialEos{165e9, -1.23456789e11, 9.87654321e12, -0.0};  // a plain -0.0 keeps its sign
     poly.strength = m::ElasticStrength{};
     poly.failure = {};
     materials.push_back(poly);
@@ -254,6 +254,9 @@ TEST(MaterialLibrary, EveryMaterialPrintsAsATableThatReadsBackBitForBit) {
     EXPECT_NE(copper.find("a = \"90 MPa\""), std::string::npos) << copper;
     EXPECT_NE(copper.find("shear_modulus = \"46 GPa\""), std::string::npos) << copper;
     EXPECT_NE(copper.find("sound_speed = \"3940 m/s\""), std::string::npos) << copper;
+    // Zero is 0 in any unit (Armco iron's K2 and K3), not 0.000000 MPa.
+    const std::string iron = material_as_toml(builtin_material("Armco iron"));
+    EXPECT_NE(iron.find("k2 = \"0 MPa\", k3 = \"0 MPa\""), std::string::npos) << iron;
 }
 
 // `gpa check` shows what a material derived with `base` changes: exactly the constants the table

@@ -121,6 +121,13 @@ TEST(Units, LetterCaseMattersAndIsHinted) {
     const std::string m = unit_error("3 MM", D::Length);
     EXPECT_NE(m.find("did you mean \"mm\""), std::string::npos) << m;
     EXPECT_NE(unit_error("3 mpa", D::Pressure).find("did you mean \"MPa\""), std::string::npos);
+    // Also where the letters would read as a compound of another size: a listed unit mistyped.
+    EXPECT_NE(unit_error("200 mPa", D::Pressure).find("did you mean \"MPa\""), std::string::npos);
+    EXPECT_NE(unit_error("1 mbar", D::Pressure).find("did you mean \"Mbar\""), std::string::npos);
+    EXPECT_NE(unit_error("10 Mm", D::Length).find("did you mean \"mm\""), std::string::npos);
+    EXPECT_NE(unit_error("1 Ms", D::Time).find("did you mean \"ms\""), std::string::npos);
+    EXPECT_NE(unit_error("3 mJ/kg", D::SpecificEnergy).find("did you mean \"MJ/kg\""), std::string::npos);
+    EXPECT_THROW(parse_any_quantity("200 mPa"), UnitError);
 }
 
 TEST(Units, MissingUnitIsAnErrorExceptForPlainNumbers) {
@@ -216,7 +223,14 @@ TEST(Units, CompoundAndCustomaryUnits) {
     for (const Case& c : customary) {
         EXPECT_NEAR(parse_quantity(c.text, c.dimension), c.si, 1e-15 * c.si) << c.text;
     }
-    EXPECT_NEAR(parse_quantity("1 ksi", D::Pressure), 6.894757293168361e6, 1.0) << "the ksi of the handbooks";
+    EXPECT_NEAR(parse_quantity("1 ksi", D::Pressure), 6.894757293168361e6, 1e-15 * 6.894757293168361e6)
+        << "the ksi of the handbooks";
+    // A customary factor that takes a number below the smallest normal double is out of range, as
+    // the decimal units are (not 0 or a subnormal).
+    for (const char* text : {"3e-324 ft", "5e-324 in", "1e-320 in"}) {
+        EXPECT_THROW(parse_quantity(text, D::Length), UnitError) << text;
+    }
+    EXPECT_EQ(parse_quantity("0 ft", D::Length), 0.0);
 }
 
 // The unit table: every listed unit that is a compound of base units reads the same as that
@@ -261,6 +275,7 @@ TEST(Units, CompoundsOfNoQuantityAndMalformedCompoundsAreRefused) {
     EXPECT_THROW(parse_quantity("1 " + overflow, D::Dimensionless), UnitError);
     EXPECT_THROW(parse_quantity("1e305 ksi", D::Pressure), UnitError);  // 1e308 as written, infinite in Pa
     EXPECT_FALSE(compound_unit_value("furlong").has_value());
+    EXPECT_FALSE(compound_unit_value("Gm^9.Gm^9/nm^9/nm^9").has_value()) << "one of it is beyond a double: none, no throw";
     EXPECT_EQ(compound_unit_value("mm/ms")->dimension, D::Velocity);
     // A compound of another dimension still says which it is.
     EXPECT_NE(unit_error("3 lbf/in^2", D::Length).find("is a pressure, not a length"), std::string::npos);

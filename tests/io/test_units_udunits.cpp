@@ -1,7 +1,7 @@
 // gpa's unit reader against UDUNITS-2 (Unidata's maintained unit database, Debian's
 // libudunits2-dev), an independent reference for every conversion factor: each listed unit and
-// each compound spelling below reads within two roundings of UDUNITS-2's value, in the same
-// dimension. (gpa keeps its own reader: UDUNITS-2 converts "x mm" by multiplying, so 560 of the
+// each compound spelling below reads as UDUNITS-2's value, in the same dimension, decimal units
+// within two roundings and customary ones within a few (below). (gpa keeps its own reader: UDUNITS-2 converts "x mm" by multiplying, so 560 of the
 // 2000 values of Units.DecimalUnitsAreRoundOffExact come out one rounding off the decimal value;
 // it reads "J/kg.K" as J K / kg where engineers mean J/(kg K); and it needs its XML database at
 // run time, a file a program embedding gpa would have to ship. Measured 2026-12-03, UDUNITS 2.2.28.)
@@ -50,18 +50,29 @@ TEST(UnitsAgainstUdunits, EveryListedAndCompoundSpellingHasTheReferenceValue) {
         if (u.symbol == "%" || std::string(u.symbol).find("kg.K") != std::string::npos) continue;
         spellings.emplace_back(u.symbol);
     }
-    for (const char* compound : {"mm/ms", "GN/m^2", "N/mm^2", "lbf/in^2", "ksi", "psi", "ft/s", "lb/in^3", "lb/ft^3",
-                                 "microseconds", "milliseconds", "feet", "inches", "g/mm^3", "kJ/g", "m s^-1",
-                                 "J kg^-1 K^-1", "m^2/s^2/K", "kbar", "km/s", "1/us"}) {
-        spellings.emplace_back(compound);
+    std::vector<bool> decimal;  // a decimal unit: no customary factor
+    for (const Unit& u : known_units()) {
+        if (u.symbol == "%" || std::string(u.symbol).find("kg.K") != std::string::npos) continue;
+        decimal.push_back(u.factor == 1.0 && u.symbol != "min" && u.symbol != "h");
     }
-    for (const std::string& unit : spellings) {
+    for (const char* compound : {"mm/ms", "GN/m^2", "N/mm^2", "g/mm^3", "kJ/g", "m s^-1", "J kg^-1 K^-1", "m^2/s^2/K",
+                                 "kbar", "km/s", "1/us", "microseconds", "milliseconds"}) {
+        spellings.emplace_back(compound);
+        decimal.push_back(true);
+    }
+    for (const char* compound : {"lbf/in^2", "ksi", "psi", "ft/s", "lb/in^3", "lb/ft^3", "feet", "inches"}) {
+        spellings.emplace_back(compound);
+        decimal.push_back(false);
+    }
+    for (std::size_t k = 0; k < spellings.size(); ++k) {
+        const std::string& unit = spellings[k];
         const auto ours = parse_any_quantity("1 " + unit);
         const double theirs = reference_value(reference.system, unit, ours.dimension);
         ASSERT_FALSE(std::isnan(theirs)) << unit << ": UDUNITS-2 does not read it as a " << name_of(ours.dimension);
-        // A few roundings on either side: one per customary factor or power (up to four here) and one
-        // for the number; 1e-15 is about nine of 1.1e-16. Decimal units agree to one rounding.
-        EXPECT_NEAR(ours.value, theirs, 1e-15 * std::abs(theirs)) << unit;
+        // Decimal units: ours is the correctly rounded power of ten, theirs a product of rounded
+        // factors: two roundings (4.5e-16). Customary ones: one rounding per factor or power on
+        // either side (up to four here) and one for the number; 1e-15 is about nine of 1.1e-16.
+        EXPECT_NEAR(ours.value, theirs, (decimal[k] ? 4.5e-16 : 1e-15) * std::abs(theirs)) << unit;
     }
     EXPECT_GT(spellings.size(), 60u);
 }

@@ -617,14 +617,21 @@ std::string_view name_of(NoseKind k) {
     return "?";
 }
 
+namespace {
+
+// The arc radius of an ogive nose, rho = CRH x 2R (scene.hpp, NoseSpec).
+double ogive_arc_radius(const NoseSpec& nose, double radius) { return nose.calibre_radius * 2.0 * radius; }
+
+}  // namespace
+
 double nose_length(const NoseSpec& nose, double radius) {
     switch (nose.kind) {
         case NoseKind::Cone: return nose.length;
         case NoseKind::Hemisphere: return radius;
-        case NoseKind::Ogive: {
-            const double rho = nose.calibre_radius * 2.0 * radius;
-            return std::sqrt(rho * rho - (rho - radius) * (rho - radius));
-        }
+        case NoseKind::Ogive:
+            // sqrt(rho^2 - (rho - R)^2), written without the difference of two nearly equal squares
+            // (a long ogive, rho >> R, would lose its length to round-off).
+            return std::sqrt(radius * (2.0 * ogive_arc_radius(nose, radius) - radius));
     }
     return 0.0;
 }
@@ -686,8 +693,9 @@ double cylinder_radius_at(const BodySpec& b, double height) {
         case NoseKind::Cone: return R * (1.0 - s / nose);
         case NoseKind::Hemisphere: return std::sqrt(std::max(R * R - s * s, 0.0));
         case NoseKind::Ogive: {
-            const double rho = b.nose->calibre_radius * 2.0 * R;
-            return std::max(std::sqrt(std::max(rho * rho - s * s, 0.0)) - (rho - R), 0.0);
+            // sqrt(rho^2 - s^2) - (rho - R) = R - s^2 / (rho + sqrt(rho^2 - s^2)), without cancellation.
+            const double rho = ogive_arc_radius(*b.nose, R);
+            return std::max(R - s * s / (rho + std::sqrt(std::max(rho * rho - s * s, 0.0))), 0.0);
         }
     }
     return R;

@@ -76,8 +76,8 @@ struct Quantity {
 // Reads a quantity of any dimension, taken from its unit; a bare number is dimensionless.
 Quantity parse_any_quantity(std::string_view text);
 
-// One unit read as a compound: products and quotients of the base units m, g, s, K, Pa, N, J, bar
-// (each with an optional SI prefix n, u, m, c, k, M, G), cc, min, h, in, ft, lb, lbf, psi, ksi
+// One unit read as a compound: products and quotients of the base units m, g, s, Pa, N, J, bar
+// (each with an optional SI prefix n, u, m, c, k, M, G), K, cc, min, h, in, ft, lb, lbf, psi, ksi
 // (and spelt-out words such as "microseconds" or "feet"), each with an optional integer power
 // ("m^3", "m3", "s^-1"); a space, '.', '*' or the middle dot multiplies, and everything after the
 // first '/' divides ("J/kg.K" and "J/(kg K)" are both J/(kg K); parentheses may enclose the whole
