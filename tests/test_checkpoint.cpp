@@ -35,6 +35,7 @@ std::string totals_bytes(const Totals& t) {
     for (const auto& p : t.planes) {
         add(p.reaction);
         add(p.impulse);
+        add(p.friction_work);
     }
     add(t.energy_given);
     for (const auto& r : t.regions) {
@@ -107,6 +108,10 @@ std::vector<Case> cases() {
         scene.stop = {};
         scene.stop.max_steps = 100000;
         out.push_back({"elastic bar on a lift-off plane, bond viscosity", scene, 211, 300});
+        // The same on a plane with Coulomb friction: the ring slides out along it and sticks.
+        scene.planes[0].friction_dynamic = 0.3;
+        scene.planes[0].friction_static = 0.5;
+        out.push_back({"elastic bar on a plane with friction", scene, 151, 260});
     }
     {
         auto scene = three_d_quarter_bar(4);

@@ -130,7 +130,10 @@ std::string history_header(const Totals& first, int dim) {
         header += fmt::format(",max_{}{}", stem, unit);
     }
     header += ",face_plastic_strain_roughness";
-    for (const auto& p : first.planes) header += fmt::format(",{0}_reaction_N,{0}_impulse_N_s", p.name.empty() ? "plane" : p.name);
+    for (const auto& p : first.planes) {
+        header += fmt::format(",{0}_reaction_N,{0}_impulse_N_s", p.name.empty() ? "plane" : p.name);
+        if (p.friction) header += fmt::format(",{}_friction_work_J", p.name.empty() ? "plane" : p.name);
+    }
     for (const auto& r : first.regions) {
         const std::string name = r.name.empty() ? "region" : r.name;
         for (const char* quantity : {"reaction", "impulse", "displacement"}) {
@@ -158,6 +161,7 @@ std::uint64_t history_digest(std::string_view bytes, std::uint64_t digest) {
 
 HistoryWriter::HistoryWriter(const fs::path& file, const Totals& first, int dim)
     : path_(file), dim_(dim), planes_(first.planes.size()) {
+    for (const auto& p : first.planes) friction_.push_back(p.friction);
     for (const auto& r : first.regions) regions_.push_back(r.held);
     fd_ = ::open(file.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
     if (fd_ < 0) throw OutputError(fmt::format("cannot write '{}': {}", file.string(), std::strerror(errno)));
@@ -226,6 +230,7 @@ std::string HistoryWriter::kept_for_resume(const fs::path& file, const Totals& f
 
 HistoryWriter::HistoryWriter(const fs::path& file, const Totals& first, int dim, const std::string& text)
     : path_(file), dim_(dim), planes_(first.planes.size()) {
+    for (const auto& p : first.planes) friction_.push_back(p.friction);
     for (const auto& r : first.regions) regions_.push_back(r.held);
     write_text_file(file, text);
     fd_ = ::open(file.c_str(), O_WRONLY | O_APPEND | O_CLOEXEC);
@@ -271,6 +276,7 @@ void HistoryWriter::write(const Totals& t) {
     for (std::size_t p = 0; p < planes_; ++p) {
         const PlaneReport r = p < t.planes.size() ? t.planes[p] : PlaneReport{};
         row += fmt::format(",{:.9e},{:.9e}", r.reaction, r.impulse);
+        if (p < friction_.size() && friction_[p]) row += fmt::format(",{:.9e}", r.friction_work);
     }
     for (std::size_t k = 0; k < regions_.size(); ++k) {
         const RegionReport r = k < t.regions.size() ? t.regions[k] : RegionReport{};
@@ -476,8 +482,11 @@ void write_summary(const fs::path& file, const Simulation& sim, const RunSummary
                                 json_number(t.energy_error)));
     std::string planes = "[";
     for (std::size_t p = 0; p < t.planes.size(); ++p) {
-        planes += fmt::format("{}{{\"name\": {}, \"reaction_N\": {}, \"impulse_N_s\": {}}}", p ? ", " : "",
-                              json_string(t.planes[p].name), json_number(t.planes[p].reaction), json_number(t.planes[p].impulse));
+        const std::string friction =
+            t.planes[p].friction ? fmt::format(", \"friction_work_J\": {}", json_number(t.planes[p].friction_work)) : std::string();
+        planes += fmt::format("{}{{\"name\": {}, \"reaction_N\": {}, \"impulse_N_s\": {}{}}}", p ? ", " : "",
+                              json_string(t.planes[p].name), json_number(t.planes[p].reaction), json_number(t.planes[p].impulse),
+                              friction);
     }
     field("planes", planes + "]");
     std::string regions = "[";

@@ -35,7 +35,8 @@ const std::vector<std::string_view> body_keys{
     "length",  "spacing",   "spacing_z", "velocity",      "initial_stress", "connectivity",    "lattice_neighbours",
     "discretisation", "inner_radius", "nose",
 };
-const std::vector<std::string_view> plane_keys{"name", "kind", "axis", "position", "side", "lift_off"};
+const std::vector<std::string_view> plane_keys{"name", "kind", "axis", "position", "side", "lift_off", "friction",
+                                               "static_friction"};
 const std::vector<std::string_view> prescribed_keys{"name", "body", "region", "velocity", "ramp"};
 const std::vector<std::string_view> region_keys{"box", "above", "below", "beyond_radius", "within_radius"};
 const std::vector<std::string_view> stop_keys{"end_time", "kinetic_energy_fraction", "max_steps", "energy_error"};
@@ -349,6 +350,22 @@ PlaneSpec read_plane(const Reporter& reporter, const toml::table& table, std::si
             r.fail_at("lift_off", "applies to rigid planes only (a symmetry plane always holds its nodes)");
         }
         p.lift_off = *lift_off;
+    }
+    // Coulomb friction: `friction` the coefficient of sliding, `static_friction` that of sticking
+    // (default: the same).
+    for (const std::string_view key : {"friction", "static_friction"}) {
+        if (r.has(key) && p.kind == PlaneKind::Symmetry) {
+            r.fail_at(key, "applies to rigid planes only (a symmetry plane is a mirror: nothing slides on it)");
+        }
+    }
+    if (const auto mu = r.quantity("friction", D::Dimensionless, Limit::NonNegative)) p.friction_dynamic = p.friction_static = *mu;
+    if (const auto mu = r.quantity("static_friction", D::Dimensionless, Limit::NonNegative)) {
+        if (!r.has("friction")) r.fail_at("static_friction", "needs friction (the coefficient of sliding) too");
+        if (*mu < p.friction_dynamic) {
+            r.fail_at("static_friction", fmt::format("{} is below friction = {}: sticking takes at least the force of sliding",
+                                                     *mu, p.friction_dynamic));
+        }
+        p.friction_static = *mu;
     }
     return p;
 }

@@ -362,6 +362,24 @@ void check_plane(const Scene& scene, const PlaneSpec& p, std::size_t i) {
         fail(fmt::format("{}.side = {} must be +1 (bodies above the plane) or -1 (below)", label, p.side));
     }
     if (!finite(p.position)) fail(fmt::format("{}.position must be finite", label));
+    // Coulomb friction (RigidPlanes::apply_friction): rigid planes, particle bodies.
+    if (p.friction_static != 0.0 || p.friction_dynamic != 0.0) {
+        if (p.kind != PlaneKind::Rigid) fail(fmt::format("{}: friction applies to rigid planes only", label));
+        if (!(p.friction_dynamic >= 0.0 && finite(p.friction_dynamic))) {
+            fail(fmt::format("{}.friction = {} must be a number >= 0", label, p.friction_dynamic));
+        }
+        if (!(p.friction_static >= p.friction_dynamic && finite(p.friction_static))) {
+            fail(fmt::format("{}.static_friction = {} must be at least friction = {}", label, p.friction_static,
+                             p.friction_dynamic));
+        }
+        for (std::size_t k = 0; k < scene.bodies.size(); ++k) {
+            if (scene.bodies[k].discretisation == Discretisation::Elements) {
+                fail(fmt::format("{}: friction acts on particle bodies only, and {} is discretised by elements (their "
+                                 "contact with planes is frictionless)",
+                                 label, body_label(scene.bodies[k], k)));
+            }
+        }
+    }
     const char letter = axis_letter(p.axis, dim);
     if (g == GeometryKind::Axisymmetric && p.axis == 0 && p.position <= 0.0) {
         fail(fmt::format("{}: a plane normal to x must lie at x > 0 in an axisymmetric scene (the axis x = 0 is a "

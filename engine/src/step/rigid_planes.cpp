@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <utility>
 
 #include <tbb/blocked_range.h>
@@ -10,15 +11,74 @@
 #include "reduce_grain.hpp"
 
 namespace gpa {
-namespace {
 
-
-}  // namespace
-
-void RigidPlanes::assign(std::vector<std::size_t> rigid) {
+void RigidPlanes::assign(std::vector<std::size_t> rigid, std::vector<std::array<double, 2>> friction) {
     ghost_plane_ = std::move(rigid);
+    friction_ = std::move(friction);
+    friction_.resize(ghost_plane_.size(), {0.0, 0.0});
+    with_friction_ = std::any_of(friction_.begin(), friction_.end(), [](const auto& mu) { return mu[1] > 0.0 || mu[0] > 0.0; });
     reaction_.assign(ghost_plane_.size(), 0.0);
     impulse_.assign(ghost_plane_.size(), 0.0);
+    friction_work_.assign(ghost_plane_.size(), 0.0);
+    pressing_impulse_.assign(ghost_plane_.size(), 0.0);
+}
+
+void RigidPlanes::apply_friction(const GhostSet& ghosts, NodeStore& nodes, std::size_t real, double dt_avg) {
+    friction_forces_.clear();
+    if (!with_friction_ || ghosts.empty() || !(dt_avg > 0.0)) return;
+    const int dim = nodes.dim();
+    // The rigid plane of each ghost plane (or none).
+    std::vector<int> rigid_of(ghosts.planes().size(), -1);
+    for (std::size_t k = 0; k < ghost_plane_.size(); ++k) rigid_of[ghost_plane_[k]] = static_cast<int>(k);
+    // In ghost order (one order on any thread count; a node has at most one ghost per plane).
+    for (std::size_t g = 0; g < ghosts.count(); ++g) {
+        const std::uint8_t mask = ghosts.planes_of(g);
+        if (mask == 0 || (mask & (mask - 1)) != 0) continue;  // a corner ghost: no single plane's push
+        std::size_t p = 0;
+        while (((mask >> p) & 1u) == 0) ++p;
+        const int k = rigid_of[p];
+        if (k < 0) continue;
+        const auto [mu_static, mu_dynamic] = friction_[static_cast<std::size_t>(k)];
+        if (!(mu_static > 0.0 || mu_dynamic > 0.0)) continue;
+        const GhostPlane& plane = ghosts.planes()[p];
+        const NodeIndex i = ghosts.source(g);
+        if (i >= real || nodes.velocity_region[i] != 0) continue;
+        const double push = -plane.side * nodes.force[plane.axis][real + g];
+        if (!(push > 0.0)) continue;
+        pressing_impulse_[static_cast<std::size_t>(k)] += push * dt_avg;
+        const double m = nodes.mass[i];
+        std::array<double, 3> w{0, 0, 0};
+        double w2 = 0.0;
+        for (int c = 0; c < dim; ++c) {
+            if (c == plane.axis) continue;
+            w[c] = nodes.velocity[c][i] + dt_avg * nodes.force[c][i] / m;
+            w2 += w[c] * w[c];
+        }
+        if (!(w2 > 0.0)) continue;
+        const double speed = std::sqrt(w2);
+        // Sticking needs M |w| / dt_avg; up to mu_s N the plane holds the node, beyond it the node slides.
+        const double scale = m * speed / dt_avg <= mu_static * push ? m / dt_avg : mu_dynamic * push / speed;
+        FrictionForce f{i, static_cast<std::size_t>(k), {0, 0, 0}, {0, 0, 0}};
+        for (int c = 0; c < dim; ++c) {
+            f.velocity[c] = nodes.velocity[c][i];
+            if (c == plane.axis) continue;
+            f.force[c] = -scale * w[c];
+            nodes.force[c][i] += f.force[c];
+        }
+        friction_forces_.push_back(f);
+    }
+}
+
+void RigidPlanes::book_friction(NodeStore& nodes, double dt_avg) {
+    const int dim = nodes.dim();
+    for (const FrictionForce& f : friction_forces_) {
+        double power = 0.0;
+        for (int c = 0; c < dim; ++c) power += f.force[c] * 0.5 * (f.velocity[c] + nodes.velocity[c][f.node]);
+        const double heat = -power * dt_avg;
+        nodes.internal_energy[f.node] += heat / nodes.mass[f.node];
+        friction_work_[f.plane] += heat;
+    }
+    friction_forces_.clear();
 }
 
 const GhostPlane* RigidPlanes::first(const GhostSet& ghosts) const {
@@ -68,19 +128,27 @@ void RigidPlanes::report(const GhostSet& ghosts, const std::vector<double>* elem
     for (std::size_t k = 0; k < ghost_plane_.size(); ++k) {
         const double element_reaction = element_reactions ? (*element_reactions)[k] : 0.0;
         const double element_impulse = element_impulses ? (*element_impulses)[k] : 0.0;
-        out.push_back({ghosts.planes()[ghost_plane_[k]].name, reaction_[k] + element_reaction, impulse_[k] + element_impulse});
+        out.push_back({ghosts.planes()[ghost_plane_[k]].name, reaction_[k] + element_reaction, impulse_[k] + element_impulse,
+                       friction_[k][0] > 0.0 || friction_[k][1] > 0.0, friction_work_[k], pressing_impulse_[k]});
     }
 }
 
 void RigidPlanes::write_state(StateWriter& out) const {
     out.array(impulse_);
     out.array(reaction_);
+    out.array(friction_work_);
+    out.array(pressing_impulse_);
 }
 
 void RigidPlanes::read_state(StateReader& in) {
     in.array(impulse_);
     in.array(reaction_);
-    if (impulse_.size() != ghost_plane_.size() || reaction_.size() != ghost_plane_.size()) in.fail("its planes are not the scene's");
+    in.array(friction_work_);
+    in.array(pressing_impulse_);
+    if (impulse_.size() != ghost_plane_.size() || reaction_.size() != ghost_plane_.size() ||
+        friction_work_.size() != ghost_plane_.size() || pressing_impulse_.size() != ghost_plane_.size()) {
+        in.fail("its planes are not the scene's");
+    }
 }
 
 }  // namespace gpa

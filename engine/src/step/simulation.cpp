@@ -140,14 +140,18 @@ void Simulation::Impl::setup() {
     // Planes with ghosts: the axis of an axisymmetric scene first, then the scene's planes.
     std::vector<GhostPlane> planes;
     std::vector<std::size_t> rigid;
+    std::vector<std::array<double, 2>> friction;
     if (G::axisymmetric) planes.push_back({"axis", 0, 0.0, +1, false, false});
     for (const auto& p : scene.planes) {
-        if (p.kind == PlaneKind::Rigid) rigid.push_back(planes.size());
+        if (p.kind == PlaneKind::Rigid) {
+            rigid.push_back(planes.size());
+            friction.push_back({p.friction_static, p.friction_dynamic});
+        }
         planes.push_back({p.name, p.axis, p.position, p.side, p.kind == PlaneKind::Rigid && p.lift_off,
                           p.kind == PlaneKind::Rigid});
     }
     ghosts = GhostSet(planes);
-    rigid_planes.assign(std::move(rigid));
+    rigid_planes.assign(std::move(rigid), std::move(friction));
     const auto mirrors = ghosts.mirror_planes();
     for (std::size_t b = 0; b < scene.bodies.size(); ++b) {
         if (scene.bodies[b].discretisation == Discretisation::Particles) add_body_nodes(nodes, scene, b, mirrors);
@@ -392,6 +396,7 @@ void Simulation::Impl::integrate(double dt_avg) {
     HeldNodes& held = regions.particles();
     if (!held.empty()) held.capture({velocity[0], velocity[1], velocity[2]}, d);
     ledger.keep_half_step_velocities(nodes, real);
+    rigid_planes.apply_friction(ghosts, nodes, real, dt_avg);  // Coulomb friction joins the forces
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, real, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
         for (int c = 0; c < d; ++c) {
             double* v = nodes.velocity[c].data();
@@ -403,6 +408,7 @@ void Simulation::Impl::integrate(double dt_avg) {
         regions.book(held.impose(scene.prescribed_velocities, d, time + 0.5 * dt_next, dt_avg, velocity, nodes.mass.data()), dt_avg);
     }
     rigid_planes.add_impulses(dt_avg);
+    rigid_planes.book_friction(nodes, dt_avg);  // its work becomes heat of the nodes it acted on
     if (ledger.compatible() && particles) {
         auto f = force_fields<G::dim>(nodes, a());
         f.pairs = contact.fields(f.pairs, nodes);

@@ -119,7 +119,7 @@ struct BodySpec {
 double cylinder_radius_at(const BodySpec& b, double height);
 
 enum class PlaneKind {
-    Rigid,     // a frictionless rigid wall; pushes only unless lift_off is false
+    Rigid,     // a rigid wall; pushes only unless lift_off is false; frictionless unless given friction
     Symmetry,  // a mirror plane; ghost pairs always act
 };
 
@@ -132,6 +132,11 @@ struct PlaneSpec {
     double position = 0.0;  // coordinate of the plane along `axis`
     int side = +1;          // the bodies lie where the coordinate is above (+1) or below (-1) the plane
     bool lift_off = true;   // rigid only: false = the paper's no-lift-off (nodes on it may not leave)
+    // Rigid only: Coulomb friction (RigidPlanes::apply_friction). A node the plane pushes with N
+    // sticks while the tangential force that would stop it is at most friction_static N, and
+    // slides against a force friction_dynamic N otherwise; 0 and 0: frictionless.
+    double friction_static = 0.0;
+    double friction_dynamic = 0.0;
 };
 
 // Nodes of one body held at a prescribed velocity (a grip, a clamp, a piston): every node of

@@ -90,6 +90,7 @@ private:
     std::filesystem::path path_;
     int dim_;
     std::size_t planes_;
+    std::vector<bool> friction_;  // per plane: it has friction (a friction-work column)
     std::vector<std::array<bool, 3>> regions_;  // the held components of each prescribed-velocity region
 };
 
