@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Fixed connectivity on the copper Taylor bar (scenes/taylor-copper-190.toml) at 10, 15 and 20
 # nodes across the radius: the run never crashes. It finishes (exit 0), or it stops where a
-# lattice cell collapses with exit code 3, the output kept, and a message that names the node
+# lattice cell collapses with exit code 3, the output kept, and a message that names the node (by its id)
 # and what to change.
 # Usage: test_fixed_connectivity.sh GPA_BINARY SOURCE_DIR WORK_DIR
 set -u
@@ -20,7 +20,7 @@ for spacing in 0.381 0.254 0.1905; do
     continue
   fi
   [[ $code -eq 3 ]] || fail "spacing $spacing mm: exit $code, expected 0 or 3: $(head -c 400 err.txt)"
-  grep -q 'node [0-9]* of body "bar" at (' err.txt || fail "spacing $spacing mm: the message does not name the node: $(head -c 400 err.txt)"
+  grep -q 'node id [0-9]* (index [0-9]*) of body "bar" at (' err.txt || fail "spacing $spacing mm: the message does not name the node: $(head -c 400 err.txt)"
   grep -q 'connectivity = \\"automatic\\"\|connectivity = "automatic"' err.txt || fail "spacing $spacing mm: no remedy in: $(head -c 400 err.txt)"
   grep -q 'step [0-9]* at t = ' err.txt || fail "spacing $spacing mm: no step and time in: $(head -c 400 err.txt)"
   [[ -s "run-$spacing.partial/history.csv" && -s "run-$spacing.partial/summary.json" ]] || fail "spacing $spacing mm: output not kept"
