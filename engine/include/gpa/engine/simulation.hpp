@@ -49,7 +49,7 @@ struct PlaneReport {
     std::string name;
     double reaction = 0.0;  // normal force the plane exerts on the bodies, F^{n+1} of the last step (N; ring total in axisymmetric)
     double impulse = 0.0;   // time integral of the reaction since t = 0 (N s)
-    bool friction = false;  // the plane has Coulomb friction (PlaneSpec::friction_dynamic > 0)
+    bool friction = false;  // the plane has Coulomb friction (PlaneSpec::friction_static or friction_dynamic > 0)
     double friction_work = 0.0;  // heat its friction has made since t = 0, J (>= 0; in the bodies' internal energy)
     // The part of `impulse` that pressed nodes against it, since t = 0 (N s): the sum over nodes of
     // their push where it was one (impulse also counts the pull of nodes in tension on a plane they
