@@ -57,6 +57,9 @@ void write_vtu(const std::filesystem::path& path, const ElementMesh& mesh) {
     for (const auto& a : point_arrays) point_offsets.push_back(data.add_float(points, a.components, a.value));
     for (const auto& a : cell_arrays) cell_offsets.push_back(data.add_float(cells, a.components, a.value));
     const std::uint64_t positions = data.add_float(points, 3, vector(n.position));
+    // The node ids, as the particle snapshots write them (vtk.cpp): an element node keeps its index
+    // for the whole run (the mesh is never reordered), so that index is its id.
+    const std::uint64_t ids = data.add_int64(points, [](std::size_t i) { return static_cast<std::int64_t>(i); });
     // Triangle 4q + k is (centre, corner k, corner k + 1) of quadrilateral q (elements.hpp).
     const std::uint64_t connectivity = data.add_int64(3 * cells, [&](std::size_t e) {
         const std::size_t t = e / 3, q = t / 4, k = t % 4, a = e % 3;
@@ -80,7 +83,15 @@ void write_vtu(const std::filesystem::path& path, const ElementMesh& mesh) {
             }
             out << fmt::format("      </{}>\n", tag);
         };
-        arrays("PointData", point_arrays, point_offsets);
+        out << "      <PointData>\n";
+        for (std::size_t k = 0; k < point_arrays.size(); ++k) {
+            out << fmt::format("        <DataArray type=\"Float64\" Name=\"{}\" NumberOfComponents=\"{}\" format=\"appended\" "
+                               "offset=\"{}\"/>\n",
+                               point_arrays[k].name, point_arrays[k].components, point_offsets[k]);
+        }
+        out << fmt::format("        <DataArray type=\"Int64\" Name=\"id\" NumberOfComponents=\"1\" format=\"appended\" offset=\"{}\"/>\n",
+                           ids);
+        out << "      </PointData>\n";
         arrays("CellData", cell_arrays, cell_offsets);
         out << "      <Points>\n"
             << fmt::format("        <DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"appended\" offset=\"{}\"/>\n",

@@ -151,6 +151,10 @@ TEST(ElementOutputs, VtuHoldsTheTrianglesOfEveryQuadrilateralAndTheirFields) {
     const auto mass = values<double>(block(file, "mass"));
     ASSERT_EQ(mass.size(), mesh.nodes.size());
     EXPECT_EQ(mass[3], mesh.nodes.mass[3]);
+    // Node ids, as particle snapshots have them: an element node's index, which never changes.
+    const auto ids = values<std::int64_t>(block(file, "id"));
+    ASSERT_EQ(ids.size(), mesh.nodes.size());
+    for (std::size_t i = 0; i < ids.size(); ++i) ASSERT_EQ(ids[i], static_cast<std::int64_t>(i));
 }
 
 TEST(ElementOutputs, SnapshotsOfElementBodiesJoinTheSeriesAndTheRunWritesTheirProfile) {
