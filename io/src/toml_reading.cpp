@@ -179,8 +179,9 @@ void check_non_ascii_placement(std::string_view text, const Reporter& reporter) 
     // allows non-ASCII characters only in strings and comments, so one anywhere else is an error
     // anyway, reported here before toml++ sees it. toml++ reaches the same tables for the
     // character after a backslash in a multi-line basic string and for the first character
-    // after the line break that a line-ending backslash skips; a non-ASCII character there is
-    // refused too (an escape such as \u03FB says the same).
+    // after the line break that a line-ending backslash skips, and for one after the blanks that
+    // follow a backslash (toml++ skips them looking for the line break); a non-ASCII character in
+    // these places is refused too (an escape such as \u03FB says the same).
     //
     // Where a quote opens a string is decided as toml++ decides it: only where a key or a value
     // begins (after whitespace, =, [, {, or a comma, and after the dot of a dotted key). A quote
@@ -275,6 +276,14 @@ void check_non_ascii_placement(std::string_view text, const Reporter& reporter) 
                             }
                             i = k;
                             continue;
+                        }
+                        if (at(k) >= 0x80 && k > i + 1) {
+                            // A backslash, blanks and a non-ASCII character: toml++ skips the blanks
+                            // looking for the line break and tests the character against the same tables.
+                            reporter.fail(line, "",
+                                          "a backslash followed by blanks and a non-ASCII character: a line-ending "
+                                          "backslash must be the last character on its line, and nothing else is an "
+                                          "escape TOML knows");
                         }
                         k = i + 1;
                     }
