@@ -22,17 +22,20 @@ cmake -S . -B build -DCMAKE_BUILD_TYPE=Release
 cmake --build build --target gpa_cli -j"$(nproc)"
 gpa=./build/apps/gpa
 
-# The variants of the plastic scenes (their scene files: variable connectivity, GPA weights,
-# nodal viscosity, no smoothing). Fixed connectivity alone cannot follow a Taylor bar's
-# mushrooming (its lattice neighbours are torn apart), so the automatic switch stands in for it.
+# The variants of the plastic scenes (their scene files: variable connectivity, nodal viscosity,
+# no smoothing; the Taylor bars weigh pairs with SPH-NSF at a = 1.3, the Armco cylinder with the
+# paper's weight at a = 1, so `weight` is the other of the two). Fixed connectivity alone cannot
+# follow a Taylor bar's mushrooming (its lattice neighbours are torn apart), so the automatic
+# switch stands in for it.
 plastic_variants=(
   --variant scene
   --variant scene-2t:threads=2
   --variant automatic:connectivity=automatic
-  --variant sph:weight=sph-nsf
   --variant bond:viscosity=bond
   --variant tension:smoothing=tension
 )
+paper_weight=(--variant paper-weight:weight=gpa,influence_distance=1)
+sph_weight=(--variant sph:weight=sph-nsf,influence_distance=1.3)
 # The elastic bar (no viscosity in the scene): fixed connectivity suits it, and nodal viscosity
 # shows what artificial viscosity costs in the rebound.
 elastic_variants=(
@@ -53,9 +56,9 @@ start=$SECONDS
 for scene in "${scenes[@]}"; do
   case "$scene" in
     elastic-bar) args=(--refine 1,1.5,2.25 "${elastic_variants[@]}") ;;
-    taylor-copper-*) args=(--refine 0.6666667,1,1.3333333 "${plastic_variants[@]}") ;;
-    taylor-steel-*) args=(--refine 0.6666667,1,1.3333333,2 "${plastic_variants[@]}") ;;
-    armco-cylinder-nodal) args=(--refine 0.6,0.9,1.35,2 "${plastic_variants[@]}") ;;
+    taylor-copper-*) args=(--refine 0.6666667,1,1.3333333 "${plastic_variants[@]}" "${paper_weight[@]}") ;;
+    taylor-steel-*) args=(--refine 0.6666667,1,1.3333333,2 "${plastic_variants[@]}" "${paper_weight[@]}") ;;
+    armco-cylinder-nodal) args=(--refine 0.6,0.9,1.35,2 "${plastic_variants[@]}" "${sph_weight[@]}") ;;
     *) echo "study.sh: no study is defined for '$scene'" >&2; exit 2 ;;
   esac
   echo "== $scene"
