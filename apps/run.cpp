@@ -153,6 +153,7 @@ struct RunState {
     double snapshot_slot = 0.0;
     std::vector<io::PvdEntry> snapshots;  // the scheduled ones, in order
     io::HistoryWriter::Mark history;      // history.csv as it was (not recorded by older checkpoints)
+    std::vector<io::GaugeWriter::Mark> gauges;  // each gauge_<name>.csv as it was, in the scene's gauge order
 };
 
 std::string encode(const RunState& s) {
@@ -163,6 +164,7 @@ std::string encode(const RunState& s) {
                        scene, s.overwrite ? 1 : 0, s.wall_seconds, s.output_seconds, s.snapshot_slot);
     for (const auto& e : s.snapshots) out += fmt::format("snapshot={:.17g} {} {}\n", e.time, e.part, e.file);
     out += fmt::format("history={} {:016x}\n", s.history.bytes, s.history.digest);
+    for (const auto& g : s.gauges) out += fmt::format("gauge={} {:016x}\n", g.bytes, g.digest);
     return out;
 }
 
@@ -183,12 +185,18 @@ RunState decode(const std::string& text, const std::string& source) {
             else if (key == "wall_seconds") s.wall_seconds = std::stod(value);
             else if (key == "output_seconds") s.output_seconds = std::stod(value);
             else if (key == "snapshot_slot") s.snapshot_slot = std::stod(value);
-            else if (key == "history") {
+            else if (key == "history" || key == "gauge") {
                 const auto space = value.find(' ');
                 if (space == std::string::npos) throw std::invalid_argument(value);
-                s.history.bytes = std::stoll(value.substr(0, space));
-                s.history.digest = std::stoull(value.substr(space + 1), nullptr, 16);
-                if (s.history.bytes <= 0) throw std::invalid_argument(value);
+                io::RowFile::Mark mark;
+                mark.bytes = std::stoll(value.substr(0, space));
+                mark.digest = std::stoull(value.substr(space + 1), nullptr, 16);
+                if (mark.bytes <= 0) throw std::invalid_argument(value);
+                if (key == "history") {
+                    s.history = mark;
+                } else {
+                    s.gauges.push_back(mark);
+                }
             }
             else if (key == "snapshot") {
                 const auto space = value.find(' ');
@@ -347,8 +355,11 @@ public:
         sim_.measure_bodies();
         history_.emplace(folder_.partial() / "history.csv", sim_.totals(), dimension_of(sim_.scene().geometry));
         history_->write(sim_.totals());
+        gauges_.emplace(folder_.partial(), sim_);
+        gauges_->write(sim_);
         last_row_ = sim_.steps();
         scheduled_rows_ = history_->mark();
+        scheduled_gauge_rows_ = gauges_->marks();
         snapshots_.write(sim_);
         snapshots_.wait();  // its size is the disk estimate's unit
         check_disk(sim_, schedule_, folder_.partial(), file_bytes(folder_.partial() / snapshots_.series().entries()[0].file));
@@ -376,6 +387,9 @@ public:
                                                   file.string(), present ? "is not whole" : "is missing", e.time * 1e6, checkpoint));
             }
         }
+        // The gauges' files are checked, then cut back, before the history is.
+        gauges_.emplace(folder_.partial(), sim_, checkpoint_step, every, state_.gauges, checkpoint);
+        scheduled_gauge_rows_ = gauges_->marks();
         // Checked: from here on the folder is cut back to the checkpoint.
         history_.emplace(history_file, sim_.totals(), dimension_of(scene.geometry), kept_history);
         scheduled_rows_ = history_->mark();
@@ -452,8 +466,12 @@ private:
     void write_row() {
         sim_.measure_bodies();  // the summary reports the bodies as of the last row too
         history_->write(sim_.totals());
+        gauges_->write(sim_);
         last_row_ = sim_.steps();
-        if (sim_.steps() % std::max<std::size_t>(sim_.scene().output.history_every, 1) == 0) scheduled_rows_ = history_->mark();
+        if (sim_.steps() % std::max<std::size_t>(sim_.scene().output.history_every, 1) == 0) {
+            scheduled_rows_ = history_->mark();
+            scheduled_gauge_rows_ = gauges_->marks();
+        }
     }
 
     void write_checkpoint(double wall_seconds) {
@@ -467,6 +485,7 @@ private:
         // The history up to its last scheduled row: a row off the schedule (that of an
         // interruption) is not part of the run a resume continues, and goes when it resumes.
         s.history = scheduled_rows_;
+        s.gauges = scheduled_gauge_rows_;
         s.snapshots.clear();
         for (const auto& e : snapshots_.series().entries()) {
             if (e.name.empty()) s.snapshots.push_back(e);
@@ -571,8 +590,10 @@ private:
     SnapshotSchedule schedule_;
     SnapshotWriter snapshots_;
     std::optional<io::HistoryWriter> history_;
+    std::optional<io::GaugeWriter> gauges_;  // gauge_<name>.csv, on the history's schedule
     std::size_t last_row_ = 0;  // the step of the last history row
-    io::HistoryWriter::Mark scheduled_rows_;  // history.csv as of its last row on the schedule (steps 0, every, ...)
+    io::HistoryWriter::Mark scheduled_rows_;
+    std::vector<io::GaugeWriter::Mark> scheduled_gauge_rows_;  // the gauges' files as of the same row  // history.csv as of its last row on the schedule (steps 0, every, ...)
 };
 
 int fresh_run(const RunOptions& options) {
@@ -717,6 +738,15 @@ int check_scene(const fs::path& file, const MemoryLimit& memory) {
         }
         fmt::print("  prescribed velocity \"{}\": {} nodes of body \"{}\" at {}{}\n", r.name, sim.totals().regions[k].nodes, r.body, held,
                    r.ramp > 0.0 ? fmt::format(" after a {:.4g} us ramp", r.ramp * 1e6) : std::string());
+    }
+    // Each gauge placed as the run will place it (a gauge with no node to read is refused here).
+    for (const auto& spec : scene.gauges) {
+        const Gauge gauge(spec, scene, sim.nodes(), sim.real_count());
+        const auto& ids = gauge.node_ids();
+        const std::string listed = ids.size() <= 8 ? fmt::format("{}", fmt::join(ids, ", "))
+                                                   : fmt::format("{}, ... {}", fmt::join(ids.begin(), ids.begin() + 4, ", "), ids.back());
+        fmt::print("  gauge \"{}\": {} node{} (id{} {}), {} columns in {}\n", spec.name, ids.size(), ids.size() == 1 ? "" : "s",
+                   ids.size() == 1 ? "" : "s", listed, gauge.columns().size() + 2, io::GaugeWriter::file_name(spec.name));
     }
     fmt::print("  first time step {:.3g} ns; phases: {}\n", sim.next_time_step() * 1e9, fmt::join(sim.phases(), ", "));
     if (!warning.empty()) fmt::print("  warning: {}\n", warning);

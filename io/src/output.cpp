@@ -159,17 +159,14 @@ std::uint64_t history_digest(std::string_view bytes, std::uint64_t digest) {
     return digest;
 }
 
-HistoryWriter::HistoryWriter(const fs::path& file, const Totals& first, int dim)
-    : path_(file), dim_(dim), planes_(first.planes.size()) {
-    for (const auto& p : first.planes) friction_.push_back(p.friction);
-    for (const auto& r : first.regions) regions_.push_back(r.held);
+RowFile::RowFile(const fs::path& file, const std::string& header) : path_(file) {
     fd_ = ::open(file.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
     if (fd_ < 0) throw OutputError(fmt::format("cannot write '{}': {}", file.string(), std::strerror(errno)));
-    append(history_header(first, dim));
+    append(header);
 }
 
-std::string HistoryWriter::kept_for_resume(const fs::path& file, const Totals& first, int dim, std::size_t last_step,
-                                           std::size_t every, Mark at, const std::string& checkpoint) {
+std::string RowFile::kept_for_resume(const fs::path& file, const std::string& header, std::size_t step_column,
+                                     std::size_t last_step, std::size_t every, Mark at, const std::string& checkpoint) {
     every = std::max<std::size_t>(every, 1);
     std::string old;
     {
@@ -187,12 +184,11 @@ std::string HistoryWriter::kept_for_resume(const fs::path& file, const Totals& f
         }
         old.resize(static_cast<std::size_t>(at.bytes));
         if (history_digest(old) != at.digest) {
-            throw OutputError(fmt::format("'{}' is not the history '{}' was written with (its first {} bytes differ): the checkpoint "
-                                          "belongs to another run, or the history was changed; {}",
+            throw OutputError(fmt::format("'{}' is not the file '{}' was written with (its first {} bytes differ): the checkpoint "
+                                          "belongs to another run, or the file was changed; {}",
                                           file.string(), checkpoint, at.bytes, cannot));
         }
     }
-    const std::string header = history_header(first, dim);
     if (old.compare(0, header.size(), header) != 0) {
         throw OutputError(fmt::format("'{}' does not start with the header this run writes", file.string()));
     }
@@ -206,9 +202,13 @@ std::string HistoryWriter::kept_for_resume(const fs::path& file, const Totals& f
         if (end == std::string::npos) break;  // a last line without its end: not a whole row
         const std::string_view line(old.data() + begin, end - begin);
         begin = end + 1;
-        const auto first_comma = line.find(','), second_comma = line.find(',', first_comma + 1);
-        if (first_comma == std::string::npos || second_comma == std::string::npos) continue;
-        const std::string step_text(line.substr(second_comma + 1, line.find(',', second_comma + 1) - second_comma - 1));
+        std::size_t field = 0;  // where column `step_column` starts
+        for (std::size_t c = 0; c < step_column && field != std::string::npos; ++c) {
+            field = line.find(',', field);
+            if (field != std::string::npos) ++field;
+        }
+        if (field == std::string::npos) continue;
+        const std::string step_text(line.substr(field, line.find(',', field) - field));
         if (step_text.empty() || step_text.find_first_not_of("0123456789") != std::string::npos) continue;
         const std::size_t step = static_cast<std::size_t>(std::stoull(step_text));
         if (step > last_step || step % every != 0) continue;
@@ -228,10 +228,7 @@ std::string HistoryWriter::kept_for_resume(const fs::path& file, const Totals& f
     return text;
 }
 
-HistoryWriter::HistoryWriter(const fs::path& file, const Totals& first, int dim, const std::string& text)
-    : path_(file), dim_(dim), planes_(first.planes.size()) {
-    for (const auto& p : first.planes) friction_.push_back(p.friction);
-    for (const auto& r : first.regions) regions_.push_back(r.held);
+RowFile::RowFile(const fs::path& file, const std::string& text, bool) : path_(file) {
     write_text_file(file, text);
     fd_ = ::open(file.c_str(), O_WRONLY | O_APPEND | O_CLOEXEC);
     if (fd_ < 0) throw OutputError(fmt::format("cannot write '{}': {}", file.string(), std::strerror(errno)));
@@ -239,11 +236,11 @@ HistoryWriter::HistoryWriter(const fs::path& file, const Totals& first, int dim,
     digest_ = history_digest(text);
 }
 
-HistoryWriter::~HistoryWriter() {
+RowFile::~RowFile() {
     if (fd_ >= 0) ::close(fd_);
 }
 
-void HistoryWriter::append(const std::string& text) {
+void RowFile::append(const std::string& text) {
     std::size_t done = 0;
     while (done < text.size()) {
         const ssize_t n = ::write(fd_, text.data() + done, text.size() - done);
@@ -260,6 +257,35 @@ void HistoryWriter::append(const std::string& text) {
     size_ += static_cast<long long>(text.size());
     digest_ = history_digest(text, digest_);
 }
+
+namespace {
+
+std::vector<bool> plane_friction(const Totals& first) {
+    std::vector<bool> out;
+    for (const auto& p : first.planes) out.push_back(p.friction);
+    return out;
+}
+
+std::vector<std::array<bool, 3>> held_components(const Totals& first) {
+    std::vector<std::array<bool, 3>> out;
+    for (const auto& r : first.regions) out.push_back(r.held);
+    return out;
+}
+
+}  // namespace
+
+HistoryWriter::HistoryWriter(const fs::path& file, const Totals& first, int dim)
+    : file_(file, history_header(first, dim)), dim_(dim), planes_(first.planes.size()), friction_(plane_friction(first)),
+      regions_(held_components(first)) {}
+
+std::string HistoryWriter::kept_for_resume(const fs::path& file, const Totals& first, int dim, std::size_t last_step,
+                                           std::size_t every, Mark at, const std::string& checkpoint) {
+    return RowFile::kept_for_resume(file, history_header(first, dim), 2, last_step, every, at, checkpoint);
+}
+
+HistoryWriter::HistoryWriter(const fs::path& file, const Totals& first, int dim, const std::string& text)
+    : file_(file, text, true), dim_(dim), planes_(first.planes.size()), friction_(plane_friction(first)),
+      regions_(held_components(first)) {}
 
 void HistoryWriter::write(const Totals& t) {
     std::string row = fmt::format("{:.9e},{:.6e},{},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.6e},{:.9e},{:.9e}", t.time, t.time_step,
@@ -290,7 +316,59 @@ void HistoryWriter::write(const Totals& t) {
     row += fmt::format(",{},{},{},{},{},{},{}", t.real_nodes, t.ghost_nodes, t.variable_nodes, t.failed_nodes, t.pairs,
                        t.element_nodes, t.elements);
     row += body_values(t, dim_);
-    append(row + "\n");
+    file_.append(row + "\n");
+}
+
+namespace {
+
+std::string gauge_header(const Gauge& g) {
+    std::string h = "time_s,step";
+    for (const auto& c : g.columns()) h += "," + c;
+    return h + "\n";
+}
+
+std::vector<Gauge> place_gauges(const Simulation& sim) {
+    std::vector<Gauge> out;
+    for (const auto& spec : sim.scene().gauges) out.emplace_back(spec, sim.scene(), sim.nodes(), sim.real_count());
+    return out;
+}
+
+}  // namespace
+
+GaugeWriter::GaugeWriter(const fs::path& folder, const Simulation& sim) : gauges_(place_gauges(sim)) {
+    for (const auto& g : gauges_) files_.push_back(std::make_unique<RowFile>(folder / file_name(g.spec().name), gauge_header(g)));
+}
+
+GaugeWriter::GaugeWriter(const fs::path& folder, const Simulation& sim, std::size_t last_step, std::size_t every,
+                         const std::vector<Mark>& at, const std::string& checkpoint)
+    : gauges_(place_gauges(sim)) {
+    if (at.size() != gauges_.size()) {
+        throw OutputError(fmt::format("'{}' records {} gauge file{} and the scene has {} gauge{}: the stopped run cannot be continued "
+                                      "from it (start it again with --overwrite)",
+                                      checkpoint, at.size(), at.size() == 1 ? "" : "s", gauges_.size(), gauges_.size() == 1 ? "" : "s"));
+    }
+    std::vector<std::string> kept;
+    for (std::size_t k = 0; k < gauges_.size(); ++k) {
+        kept.push_back(RowFile::kept_for_resume(folder / file_name(gauges_[k].spec().name), gauge_header(gauges_[k]), 1, last_step,
+                                                every, at[k], checkpoint));
+    }
+    for (std::size_t k = 0; k < gauges_.size(); ++k) {
+        files_.push_back(std::make_unique<RowFile>(folder / file_name(gauges_[k].spec().name), kept[k], true));
+    }
+}
+
+void GaugeWriter::write(const Simulation& sim) {
+    for (std::size_t k = 0; k < gauges_.size(); ++k) {
+        std::string row = fmt::format("{:.9e},{}", sim.time(), sim.steps());
+        for (const double v : gauges_[k].read(sim.nodes(), sim.real_count())) row += fmt::format(",{:.9e}", v);
+        files_[k]->append(row + "\n");
+    }
+}
+
+std::vector<GaugeWriter::Mark> GaugeWriter::marks() const {
+    std::vector<Mark> out;
+    for (const auto& f : files_) out.push_back(f->mark());
+    return out;
 }
 
 SnapshotSeries::SnapshotSeries(fs::path folder, std::string stem) : folder_(std::move(folder)), stem_(std::move(stem)) {}

@@ -27,8 +27,8 @@ using D = Dimension;
 constexpr std::uintmax_t max_scene_file_bytes = 16u << 20;
 
 const std::vector<std::string_view> scene_keys{
-    "name", "description", "geometry", "material", "body", "plane", "prescribed_velocity", "solver", "stop", "output",
-    "reference",
+    "name", "description", "geometry", "material", "body", "plane", "prescribed_velocity", "gauge", "solver", "stop",
+    "output", "reference",
 };
 const std::vector<std::string_view> body_keys{
     "name",    "shape",     "material", "origin",         "size",         "radius",            "diameter",
@@ -37,6 +37,7 @@ const std::vector<std::string_view> body_keys{
 };
 const std::vector<std::string_view> plane_keys{"name", "kind", "axis", "position", "side", "lift_off", "friction",
                                                "static_friction"};
+const std::vector<std::string_view> gauge_keys{"name", "kind", "at", "body", "radius", "normal", "fields"};
 const std::vector<std::string_view> prescribed_keys{"name", "body", "region", "velocity", "ramp"};
 const std::vector<std::string_view> region_keys{"box", "above", "below", "beyond_radius", "within_radius"};
 const std::vector<std::string_view> stop_keys{"end_time", "kinetic_energy_fraction", "max_steps", "energy_error"};
@@ -370,6 +371,54 @@ PlaneSpec read_plane(const Reporter& reporter, const toml::table& table, std::si
     return p;
 }
 
+// --- gauges ------------------------------------------------------------------------------------
+
+GaugeSpec read_gauge(const Reporter& reporter, const toml::table& table, std::size_t index, GeometryKind geometry) {
+    const TableReader r(reporter, table, labelled_path("gauge", table, index), "a gauge", gauge_keys);
+    const int dim = dimension_of(geometry);
+    GaugeSpec g;
+    g.name = r.required_string("name", "the gauge's name, which names its file gauge_<name>.csv");
+    const auto kind = r.choice<GaugeKind>("kind", {{"point", GaugeKind::Point}, {"free_surface", GaugeKind::FreeSurface}});
+    if (kind) g.kind = *kind;
+    const auto at = r.quantities("at", D::Length, static_cast<std::size_t>(dim), Limit::Any, components_of(dim));
+    if (!at) r.fail_missing("at", fmt::format("the gauge's point at t = 0, {} with units", components_of(dim)));
+    g.at = to_vector3(*at);
+    if (const auto body = r.string("body")) g.body = *body;
+    if (const auto radius = r.quantity("radius", D::Length, Limit::NonNegative)) g.radius = *radius;
+    if (const toml::node* normal = r.find("normal")) {
+        if (g.kind != GaugeKind::FreeSurface) {
+            r.fail_at("normal", "applies to free-surface gauges only (kind = \"free_surface\")");
+        }
+        const auto* word = normal->as_string();
+        const std::string axes = dim == 3 ? "xyz" : "xz";
+        const std::string text = word ? word->get() : std::string();
+        if (text.size() != 2 || (text[0] != '+' && text[0] != '-') || axes.find(text[1]) == std::string::npos) {
+            r.fail_at("normal", fmt::format("{} is not an outward normal: write a sign and an axis, {}", as_written(*normal),
+                                            dim == 3 ? "\"+x\", \"-x\", \"+y\", \"-y\", \"+z\" or \"-z\""
+                                                     : "\"+x\", \"-x\", \"+z\" or \"-z\""));
+        }
+        g.normal_sign = text[0] == '+' ? 1 : -1;
+        g.normal_axis = static_cast<int>(axes.find(text[1]));
+    } else if (g.kind == GaugeKind::FreeSurface) {
+        r.fail_missing("normal", "the outward normal of the face, a sign and an axis such as \"-z\"");
+    }
+    if (const toml::node* fields = r.find("fields")) {
+        const auto* list = fields->as_array();
+        if (!list || list->empty()) r.fail_at("fields", fmt::format("expected a list of field names, got {}", as_written(*fields)));
+        std::string known;
+        for (const auto word : gauge_field_words()) known += (known.empty() ? "" : ", ") + std::string(word);
+        for (std::size_t k = 0; k < list->size(); ++k) {
+            const auto* word = (*list)[k].as_string();
+            GaugeField f{};
+            if (!word || !gauge_field_of(word->get(), f)) {
+                r.fail_at("fields", fmt::format("{} is not a gauge field; the fields are {}", as_written((*list)[k]), known));
+            }
+            g.fields.push_back(f);
+        }
+    }
+    return g;
+}
+
 // --- prescribed velocities ------------------------------------------------------------------
 
 // The component names of a geometry ("x", "z" or "x", "y", "z").
@@ -581,7 +630,8 @@ void read_reference(const Reporter& reporter, const toml::table& table, Scene& s
     }
 }
 
-Scene read_scene(std::string_view text, const Reporter& reporter, std::vector<std::size_t>& region_lines) {
+Scene read_scene(std::string_view text, const Reporter& reporter, std::vector<std::size_t>& region_lines,
+                 std::vector<std::size_t>& gauge_lines) {
     check_text(text, reporter);
     const toml::table root = parse_toml(text, reporter);
     if (root.empty()) {
@@ -615,6 +665,11 @@ Scene read_scene(std::string_view text, const Reporter& reporter, std::vector<st
         scene.prescribed_velocities.push_back(read_prescribed_velocity(reporter, *region_tables[i], i, scene.geometry));
         region_lines.push_back(line_of(*region_tables[i]));
     }
+    const auto gauge_tables = tables_of(top, "gauge");
+    for (std::size_t i = 0; i < gauge_tables.size(); ++i) {
+        scene.gauges.push_back(read_gauge(reporter, *gauge_tables[i], i, scene.geometry));
+        gauge_lines.push_back(line_of(*gauge_tables[i]));
+    }
     scene.materials = scene_materials.take();
 
     const toml::table empty;
@@ -632,8 +687,8 @@ Scene read_scene(std::string_view text, const Reporter& reporter, std::vector<st
 
 Scene parse_scene(std::string_view text, const std::string& file_name_for_messages) {
     const Reporter reporter(file_name_for_messages);
-    std::vector<std::size_t> region_lines;
-    Scene scene = read_scene(text, reporter, region_lines);
+    std::vector<std::size_t> region_lines, gauge_lines;
+    Scene scene = read_scene(text, reporter, region_lines, gauge_lines);
     // The scene-level rules (shapes for the geometry, planes, spacings, option ranges, materials,
     // the nodes of prescribed-velocity regions) are the engine's, the same for a Scene built in
     // code; an error about one region points at its table.
@@ -641,6 +696,8 @@ Scene parse_scene(std::string_view text, const std::string& file_name_for_messag
         validate_scene(scene);
     } catch (const PrescribedVelocityError& e) {
         reporter.fail(e.index() < region_lines.size() ? region_lines[e.index()] : 0, "", e.what());
+    } catch (const GaugeError& e) {
+        reporter.fail(e.index() < gauge_lines.size() ? gauge_lines[e.index()] : 0, "", e.what());
     } catch (const InputError& e) {
         reporter.fail(0, "", e.what());
     }

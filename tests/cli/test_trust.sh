@@ -86,7 +86,9 @@ grep -q '"status": "finished"' far/summary.json 2> /dev/null || fail "far body: 
 
 # --- one run per output folder ---------------------------------------------------------------
 # (4000 steps of 15 ns, a snapshot every 5 us: a quarter of a second in a release build.)
-variant long.toml -e 's/^max_steps = 20/max_steps = 4000/' -e 's/^snapshots = 3/snapshot_interval = "5 us"/'
+# Two gauges (a point in the middle, the free top face), whose files resume like the history.
+with_gauges=(-e 's/^\[stop\]/[[gauge]]\nname = "middle"\nat = [0, "2 mm"]\nfields = ["velocity", "stress"]\n\n[[gauge]]\nname = "top"\nkind = "free_surface"\nat = [0, "4 mm"]\nnormal = "+z"\nradius = "1 mm"\n\n[stop]/')
+variant long.toml -e 's/^max_steps = 20/max_steps = 4000/' -e 's/^snapshots = 3/snapshot_interval = "5 us"/' "${with_gauges[@]}"
 "$gpa" run long.toml -o conc -q --threads 1 > conc-first.out 2> conc-first.err &
 first=$!
 wait_for_lines conc.partial/history.csv 20 || fail "the first run never started"
@@ -116,6 +118,10 @@ expect 0 "uninterrupted reference run" -- "$gpa" run long.toml -o whole -q --thr
 same_as_whole() {
   local dir=$1 what=$2
   cmp -s whole/history.csv "$dir/history.csv" || fail "$what: history.csv differs from the uninterrupted run's"
+  for f in gauge_middle.csv gauge_top.csv; do
+    [[ -s whole/$f ]] || fail "$what: the uninterrupted run wrote no $f"
+    cmp -s "whole/$f" "$dir/$f" || fail "$what: $f differs from the uninterrupted run's"
+  done
   cmp -s whole/particles.pvd "$dir/particles.pvd" || fail "$what: particles.pvd differs"
   local n=0
   for f in whole/particles_*.vtp; do
@@ -146,7 +152,8 @@ interrupt_and_resume INT 2 1 130
 interrupt_and_resume TERM 1 2 143
 
 # A run killed outright (kill -9) resumes from its last periodic checkpoint.
-variant every.toml -e 's/^max_steps = 20/max_steps = 4000/' -e 's/^snapshots = 3/snapshot_interval = "5 us"\ncheckpoint_every = 1000/'
+variant every.toml -e 's/^max_steps = 20/max_steps = 4000/' -e 's/^snapshots = 3/snapshot_interval = "5 us"\ncheckpoint_every = 1000/' \
+  "${with_gauges[@]}"
 expect 0 "reference with checkpoints" -- "$gpa" run every.toml -o every-whole -q --threads 2
 cmp -s whole/particles_00010.vtp every-whole/particles_00010.vtp && cmp -s whole/history.csv every-whole/history.csv || fail "writing checkpoints changed a run's results"
 "$gpa" run every.toml -o killed -q --threads 2 > /dev/null 2>&1 &
@@ -154,7 +161,7 @@ pid=$!
 wait_for_file killed.partial/checkpoint.gpack || fail "no periodic checkpoint"
 kill -9 $pid; wait $pid 2> /dev/null
 expect 0 "resume after kill -9" -- "$gpa" run --resume killed -q --threads 1
-for f in every-whole/particles_*.vtp every-whole/history.csv; do
+for f in every-whole/particles_*.vtp every-whole/history.csv every-whole/gauge_*.csv; do
   cmp -s "$f" "killed/$(basename "$f")" || fail "resumed after kill -9: $(basename "$f") differs"
 done
 

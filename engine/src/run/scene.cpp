@@ -778,6 +778,7 @@ void validate_scene(const Scene& scene) {
     }
     for (std::size_t k = 0; k < scene.prescribed_velocities.size(); ++k) check_prescribed_velocity(scene, k);
 
+    validate_gauges(scene);
     check_solver(scene.solver);
     check_stop(scene.stop);
     check_output(scene.output);

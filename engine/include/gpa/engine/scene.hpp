@@ -16,6 +16,7 @@
 
 #include "gpa/engine/colouring.hpp"
 #include "gpa/engine/errors.hpp"
+#include "gpa/engine/gauges.hpp"
 #include "gpa/engine/geometry.hpp"
 #include "gpa/engine/weights.hpp"
 #include "gpa/materials/material.hpp"
@@ -274,6 +275,8 @@ struct Scene {
     std::vector<BodySpec> bodies;
     std::vector<PlaneSpec> planes;
     std::vector<PrescribedVelocitySpec> prescribed_velocities;
+    // Material points recorded over the run (gauges.hpp); the run loop places and writes them.
+    std::vector<GaugeSpec> gauges;
     SolverOptions solver;
     StopCriteria stop;
     OutputOptions output;

@@ -15,6 +15,7 @@
 #include <string_view>
 #include <vector>
 
+#include "gpa/engine/gauges.hpp"
 #include "gpa/engine/simulation.hpp"
 #include "gpa/io/atomic_file.hpp"
 #include "gpa/io/folder_lock.hpp"
@@ -52,10 +53,10 @@ private:
     std::optional<FolderLock> lock_;
 };
 
-// history.csv: one row per call, with a header naming every column and its unit. Every row
-// goes to the file whole or not at all: a write that fails (disk full) is cut back to the rows
-// before it and reported as OutputError, so the file always ends with a complete line.
-class HistoryWriter {
+// A CSV file written a row at a time, each row reaching the file whole or not at all: a write
+// that fails (disk full) is cut back to the rows before it and reported as OutputError, so the
+// file always ends with a complete line. history.csv and the gauges' files are such files.
+class RowFile {
 public:
     // How far the file had got when a checkpoint was written: its length and the digest of those
     // bytes (bytes == 0: not recorded, as in checkpoints written before it was).
@@ -63,35 +64,76 @@ public:
         long long bytes = 0;
         std::uint64_t digest = 0;
     };
-    HistoryWriter(const std::filesystem::path& file, const Totals& first, int dim);
-    // For a resumed run from a checkpoint at step `last_step`, what of the file it keeps: the
-    // file as it was at the checkpoint (its first at.bytes bytes, which must have the recorded
-    // digest; what follows goes) with the rows of steps 0, every, 2 every, ... up to last_step,
-    // which must all be there. Reads the file and changes nothing: OutputError naming the file
-    // (and `checkpoint`) when it is missing, its header is not the one this run writes, it is
-    // shorter than at the checkpoint, it differs from the one the checkpoint recorded, or a row
-    // is missing.
-    static std::string kept_for_resume(const std::filesystem::path& file, const Totals& first, int dim, std::size_t last_step,
-                                       std::size_t every, Mark at, const std::string& checkpoint);
+    // A fresh file holding `header` (a whole line).
+    RowFile(const std::filesystem::path& file, const std::string& header);
     // A resumed run: the file rewritten (atomically) to `kept` (kept_for_resume), and appended to.
-    HistoryWriter(const std::filesystem::path& file, const Totals& first, int dim, const std::string& kept);
-    ~HistoryWriter();
-    HistoryWriter(const HistoryWriter&) = delete;
-    HistoryWriter& operator=(const HistoryWriter&) = delete;
-    void write(const Totals& t);
+    RowFile(const std::filesystem::path& file, const std::string& kept, bool resumed);
+    // For a resumed run from a checkpoint at step `last_step`, what of the file it keeps: the file
+    // as it was at the checkpoint (its first at.bytes bytes, which must have the recorded digest;
+    // what follows goes) with the rows of steps 0, every, 2 every, ... up to last_step, which must
+    // all be there (a row's step is its column `step_column`, counted from 0). Reads the file and
+    // changes nothing: OutputError naming the file (and `checkpoint`) when it is missing, its
+    // header is not `header`, it is shorter than at the checkpoint, it differs from the one the
+    // checkpoint recorded, or a row is missing.
+    static std::string kept_for_resume(const std::filesystem::path& file, const std::string& header, std::size_t step_column,
+                                       std::size_t last_step, std::size_t every, Mark at, const std::string& checkpoint);
+    ~RowFile();
+    RowFile(const RowFile&) = delete;
+    RowFile& operator=(const RowFile&) = delete;
+    // Appends whole lines.
+    void append(const std::string& text);
     // The file as it is now (for the checkpoint).
     Mark mark() const { return {size_, digest_}; }
 
 private:
-    void append(const std::string& text);
     int fd_ = -1;
     long long size_ = 0;  // bytes of whole lines in the file
     std::uint64_t digest_ = 14695981039346656037ull;  // history_digest of those bytes (of none so far)
     std::filesystem::path path_;
+};
+
+// history.csv: one row per call, with a header naming every column and its unit.
+class HistoryWriter {
+public:
+    using Mark = RowFile::Mark;
+    HistoryWriter(const std::filesystem::path& file, const Totals& first, int dim);
+    // RowFile::kept_for_resume for history.csv as this run writes it.
+    static std::string kept_for_resume(const std::filesystem::path& file, const Totals& first, int dim, std::size_t last_step,
+                                       std::size_t every, Mark at, const std::string& checkpoint);
+    // A resumed run: the file rewritten (atomically) to `kept` (kept_for_resume), and appended to.
+    HistoryWriter(const std::filesystem::path& file, const Totals& first, int dim, const std::string& kept);
+    void write(const Totals& t);
+    // The file as it is now (for the checkpoint).
+    Mark mark() const { return file_.mark(); }
+
+private:
+    RowFile file_;
     int dim_;
     std::size_t planes_;
     std::vector<bool> friction_;  // per plane: it has friction (a friction-work column)
     std::vector<std::array<bool, 3>> regions_;  // the held components of each prescribed-velocity region
+};
+
+// The gauges of a run (gauges.hpp), each written to gauge_<name>.csv in the run's folder: a row
+// per call, time_s, step, then the gauge's columns (Gauge::columns), on the history's schedule.
+class GaugeWriter {
+public:
+    using Mark = RowFile::Mark;
+    // Places the scene's gauges on the run's nodes and starts their files; nothing without gauges.
+    GaugeWriter(const std::filesystem::path& folder, const Simulation& sim);
+    // A resumed run: each file cut back to its checkpoint's mark (RowFile::kept_for_resume; the
+    // marks in the scene's gauge order), checked for every gauge before any file changes.
+    GaugeWriter(const std::filesystem::path& folder, const Simulation& sim, std::size_t last_step, std::size_t every,
+                const std::vector<Mark>& at, const std::string& checkpoint);
+    void write(const Simulation& sim);
+    std::vector<Mark> marks() const;
+    std::size_t size() const { return gauges_.size(); }
+    // The file name of a gauge.
+    static std::string file_name(const std::string& gauge) { return "gauge_" + gauge + ".csv"; }
+
+private:
+    std::vector<Gauge> gauges_;
+    std::vector<std::unique_ptr<RowFile>> files_;
 };
 
 // The digest a history Mark records (64-bit FNV-1a), carried on from `digest` over `bytes`;
