@@ -2,7 +2,7 @@
 # Regenerates the thread-scaling, memory and bandwidth figures of docs/performance.md: builds
 # gpa like scripts/test.sh, then runs gpa_bench_steps (whole steps of a Taylor bar in plastic
 # flow, per phase, 1 and 2 threads, at 10^4, 10^5 and 10^6 nodes, 2D and 3D, variable and fixed
-# connectivity), the triad bandwidth and the peak memory per node. About 20 minutes on 2 idle
+# connectivity), the triad bandwidth and the peak memory per node. About 35 minutes on 2 idle
 # cores; run it on an otherwise quiet machine. The raw output goes to docs/performance/.
 #
 # Usage: bash scripts/performance.sh

@@ -3,7 +3,7 @@
 # plots): sets up the machine and builds gpa like scripts/run.sh, then runs `gpa study` on the
 # elastic bar (analytic answers), the Taylor tests of OFHC copper at 190 m/s and 4340 steel at
 # 208 m/s (measured answers) and the paper's Armco-iron cylinder (no answer: the extrapolation is
-# its reference). About 16 minutes on 2 idle cores; run it on an otherwise quiet machine, since
+# its reference). About 11 minutes on 2 idle cores; run it on an otherwise quiet machine, since
 # the wall times are part of the record.
 #
 # Usage: bash scripts/study.sh [SCENE...]   (scene names of scenes/; default: all four)
