@@ -353,7 +353,7 @@ public:
     void start() {
         io::write_text_file(folder_.partial() / scene_copy_name, source_.text);
         sim_.measure_bodies();
-        history_.emplace(folder_.partial() / "history.csv", sim_.totals(), dimension_of(sim_.scene().geometry));
+        history_.emplace(folder_.partial() / "history.csv", sim_.totals(), io::HistoryLayout::of(sim_.scene()));
         history_->write(sim_.totals());
         gauges_.emplace(folder_.partial(), sim_);
         gauges_->write(sim_);
@@ -373,7 +373,7 @@ public:
         const std::string checkpoint = (folder_.partial() / checkpoint_name).string();
         sim_.measure_bodies();
         const fs::path history_file = folder_.partial() / "history.csv";
-        const std::string kept_history = io::HistoryWriter::kept_for_resume(history_file, sim_.totals(), dimension_of(scene.geometry),
+        const std::string kept_history = io::HistoryWriter::kept_for_resume(history_file, sim_.totals(), io::HistoryLayout::of(scene),
                                                                             checkpoint_step, every, state_.history, checkpoint);
         // Every snapshot the checkpoint lists must be there and whole (a writer's file ends with
         // its closing tag); the .pvd rewritten below lists them all.
@@ -391,7 +391,7 @@ public:
         gauges_.emplace(folder_.partial(), sim_, checkpoint_step, every, state_.gauges, checkpoint);
         scheduled_gauge_rows_ = gauges_->marks();
         // Checked: from here on the folder is cut back to the checkpoint.
-        history_.emplace(history_file, sim_.totals(), dimension_of(scene.geometry), kept_history);
+        history_.emplace(history_file, sim_.totals(), io::HistoryLayout::of(scene), kept_history);
         scheduled_rows_ = history_->mark();
         last_row_ = checkpoint_step;
         schedule_.set_last_slot(state_.snapshot_slot);

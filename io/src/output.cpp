@@ -83,17 +83,22 @@ namespace {
 
 char component_letter(int dim, int c) { return dim == 2 ? (c == 0 ? 'x' : 'z') : "xyz"[c]; }
 
+// A unit of an extensive quantity (energy, momentum, force, impulse): per metre of thickness in
+// plane strain, where the bodies are slices of unit thickness.
+std::string extensive(const HistoryLayout& layout, std::string_view unit) {
+    return layout.per_metre ? fmt::format("{}_per_m", unit) : std::string(unit);
+}
+
 // Per-body columns, for scenes of more than one body (body_report.hpp defines them).
-std::string body_columns(const Totals& t, int dim) {
+std::string body_columns(const Totals& t, const HistoryLayout& layout) {
     if (t.bodies.size() < 2) return {};
-    const char* const axes2[] = {"x", "z"};
-    const char* const axes3[] = {"x", "y", "z"};
+    const int dim = layout.dim;
     std::string h;
     for (const auto& b : t.bodies) {
         const std::string& n = b.name;
-        h += fmt::format(",{0}_kinetic_energy_J,{0}_internal_energy_J", n);
-        for (int c = 0; c < dim; ++c) h += fmt::format(",{}_momentum_{}_kg_m_s", n, dim == 3 ? axes3[c] : axes2[c]);
-        for (int c = 0; c < dim; ++c) h += fmt::format(",{}_velocity_{}_m_s", n, dim == 3 ? axes3[c] : axes2[c]);
+        h += fmt::format(",{0}_kinetic_energy_{1},{0}_internal_energy_{1}", n, extensive(layout, "J"));
+        for (int c = 0; c < dim; ++c) h += fmt::format(",{}_momentum_{}_{}", n, component_letter(dim, c), extensive(layout, "kg_m_s"));
+        for (int c = 0; c < dim; ++c) h += fmt::format(",{}_velocity_{}_m_s", n, component_letter(dim, c));
         h += fmt::format(",{0}_residual_velocity_m_s,{0}_pieces,{0}_failed_nodes", n);
         if (b.target) h += fmt::format(",{0}_crater_depth_m,{0}_crater_diameter_m,{0}_perforated", n);
     }
@@ -113,39 +118,41 @@ std::string body_values(const Totals& t, int dim) {
     return r;
 }
 
-std::string history_header(const Totals& first, int dim) {
-    std::string header =
-        "time_s,dt_s,step,kinetic_energy_J,internal_energy_J,plastic_work_J,viscous_work_J,boundary_work_J,"
-        "total_energy_error,hourglass_work_J,hourglass_energy_J";
-    header += dim == 3 ? ",momentum_x_kg_m_s,momentum_y_kg_m_s,momentum_z_kg_m_s" : ",momentum_x_kg_m_s,momentum_z_kg_m_s";
-    header += ",length_m,footprint_diameter_m,base_height_m";
+std::string history_header(const Totals& first, const HistoryLayout& layout) {
+    const int dim = layout.dim;
+    const std::string J = extensive(layout, "J");
+    std::string header = fmt::format("time_s,dt_s,step,kinetic_energy_{0},internal_energy_{0},plastic_work_{0},viscous_work_{0},"
+                                     "boundary_work_{0},total_energy_error_percent,hourglass_work_{0},hourglass_energy_{0}",
+                                     J);
+    for (int c = 0; c < dim; ++c) header += fmt::format(",momentum_{}_{}", component_letter(dim, c), extensive(layout, "kg_m_s"));
+    if (layout.specimen) header += ",length_m,footprint_diameter_m,base_height_m";
     // Local peaks (measure.hpp): the neighbourhood peak, where it is, the largest single value.
-    const char* axes = dim == 3 ? "xyz" : "xz";
     for (const char* field : {"plastic_strain", "temperature_K"}) {
         const std::string name = field;
         const std::string stem = name.substr(0, name.find("_K"));
         const std::string unit = name.size() > stem.size() ? "_K" : "";
         header += fmt::format(",peak_{}{}", stem, unit);
-        for (int c = 0; c < dim; ++c) header += fmt::format(",peak_{}_{}_m", stem, axes[c]);
+        for (int c = 0; c < dim; ++c) header += fmt::format(",peak_{}_{}_m", stem, component_letter(dim, c));
         header += fmt::format(",max_{}{}", stem, unit);
     }
-    header += ",face_plastic_strain_roughness";
+    if (layout.specimen) header += ",face_plastic_strain_roughness";
     for (const auto& p : first.planes) {
-        header += fmt::format(",{0}_reaction_N,{0}_impulse_N_s", p.name.empty() ? "plane" : p.name);
-        if (p.friction) header += fmt::format(",{}_friction_work_J", p.name.empty() ? "plane" : p.name);
+        const std::string name = p.name.empty() ? "plane" : p.name;
+        header += fmt::format(",{0}_reaction_{1},{0}_impulse_{2}", name, extensive(layout, "N"), extensive(layout, "N_s"));
+        if (p.friction) header += fmt::format(",{}_friction_work_{}", name, J);
     }
     for (const auto& r : first.regions) {
         const std::string name = r.name.empty() ? "region" : r.name;
         for (const char* quantity : {"reaction", "impulse", "displacement"}) {
-            const char* unit = quantity[0] == 'r' ? "N" : quantity[0] == 'i' ? "N_s" : "m";
+            const std::string unit = quantity[0] == 'r' ? extensive(layout, "N") : quantity[0] == 'i' ? extensive(layout, "N_s") : "m";
             for (int c = 0; c < dim; ++c) {
                 if (r.held[c]) header += fmt::format(",{}_{}_{}_{}", name, quantity, component_letter(dim, c), unit);
             }
         }
-        header += fmt::format(",{}_work_J", name);
+        header += fmt::format(",{}_work_{}", name, J);
     }
     header += ",real_nodes,ghost_nodes,variable_nodes,failed_nodes,neighbour_pairs,element_nodes,elements";
-    header += body_columns(first, dim);
+    header += body_columns(first, layout);
     return header + "\n";
 }
 
@@ -274,31 +281,39 @@ std::vector<std::array<bool, 3>> held_components(const Totals& first) {
 
 }  // namespace
 
-HistoryWriter::HistoryWriter(const fs::path& file, const Totals& first, int dim)
-    : file_(file, history_header(first, dim)), dim_(dim), planes_(first.planes.size()), friction_(plane_friction(first)),
-      regions_(held_components(first)) {}
-
-std::string HistoryWriter::kept_for_resume(const fs::path& file, const Totals& first, int dim, std::size_t last_step,
-                                           std::size_t every, Mark at, const std::string& checkpoint) {
-    return RowFile::kept_for_resume(file, history_header(first, dim), 2, last_step, every, at, checkpoint);
+HistoryLayout HistoryLayout::of(const Scene& scene) {
+    HistoryLayout layout;
+    layout.dim = dimension_of(scene.geometry);
+    layout.per_metre = scene.geometry == GeometryKind::PlaneStrain;
+    layout.specimen = std::any_of(scene.planes.begin(), scene.planes.end(), [](const PlaneSpec& p) { return p.kind == PlaneKind::Rigid; });
+    return layout;
 }
 
-HistoryWriter::HistoryWriter(const fs::path& file, const Totals& first, int dim, const std::string& text)
-    : file_(file, text, true), dim_(dim), planes_(first.planes.size()), friction_(plane_friction(first)),
+HistoryWriter::HistoryWriter(const fs::path& file, const Totals& first, const HistoryLayout& layout)
+    : file_(file, history_header(first, layout)), layout_(layout), planes_(first.planes.size()), friction_(plane_friction(first)),
+      regions_(held_components(first)) {}
+
+std::string HistoryWriter::kept_for_resume(const fs::path& file, const Totals& first, const HistoryLayout& layout,
+                                           std::size_t last_step, std::size_t every, Mark at, const std::string& checkpoint) {
+    return RowFile::kept_for_resume(file, history_header(first, layout), 2, last_step, every, at, checkpoint);
+}
+
+HistoryWriter::HistoryWriter(const fs::path& file, const Totals& first, const HistoryLayout& layout, const std::string& text)
+    : file_(file, text, true), layout_(layout), planes_(first.planes.size()), friction_(plane_friction(first)),
       regions_(held_components(first)) {}
 
 void HistoryWriter::write(const Totals& t) {
     std::string row = fmt::format("{:.9e},{:.6e},{},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.6e},{:.9e},{:.9e}", t.time, t.time_step,
                                   t.step, t.kinetic_energy, t.internal_energy, t.plastic_work, t.viscous_work,
-                                  t.boundary_work, t.energy_error, t.hourglass_work, t.hourglass_energy);
-    for (int c = 0; c < dim_; ++c) row += fmt::format(",{:.9e}", t.momentum[c]);
-    row += fmt::format(",{:.9e},{:.9e},{:.9e}", t.length, t.footprint_diameter, t.base_height);
+                                  t.boundary_work, 100.0 * t.energy_error, t.hourglass_work, t.hourglass_energy);
+    for (int c = 0; c < layout_.dim; ++c) row += fmt::format(",{:.9e}", t.momentum[c]);
+    if (layout_.specimen) row += fmt::format(",{:.9e},{:.9e},{:.9e}", t.length, t.footprint_diameter, t.base_height);
     for (const auto* peak : {&t.local.plastic_strain, &t.local.temperature}) {
         row += fmt::format(",{:.9e}", peak->value);
-        for (int c = 0; c < dim_; ++c) row += fmt::format(",{:.9e}", peak->position[c]);
+        for (int c = 0; c < layout_.dim; ++c) row += fmt::format(",{:.9e}", peak->position[c]);
         row += fmt::format(",{:.9e}", peak->raw);
     }
-    row += fmt::format(",{:.9e}", t.local.face_roughness);
+    if (layout_.specimen) row += fmt::format(",{:.9e}", t.local.face_roughness);
     for (std::size_t p = 0; p < planes_; ++p) {
         const PlaneReport r = p < t.planes.size() ? t.planes[p] : PlaneReport{};
         row += fmt::format(",{:.9e},{:.9e}", r.reaction, r.impulse);
@@ -307,7 +322,7 @@ void HistoryWriter::write(const Totals& t) {
     for (std::size_t k = 0; k < regions_.size(); ++k) {
         const RegionReport r = k < t.regions.size() ? t.regions[k] : RegionReport{};
         for (const auto& values : {r.reaction, r.impulse, r.displacement}) {
-            for (int c = 0; c < dim_; ++c) {
+            for (int c = 0; c < layout_.dim; ++c) {
                 if (regions_[k][c]) row += fmt::format(",{:.9e}", values[c]);
             }
         }
@@ -315,7 +330,7 @@ void HistoryWriter::write(const Totals& t) {
     }
     row += fmt::format(",{},{},{},{},{},{},{}", t.real_nodes, t.ghost_nodes, t.variable_nodes, t.failed_nodes, t.pairs,
                        t.element_nodes, t.elements);
-    row += body_values(t, dim_);
+    row += body_values(t, layout_.dim);
     file_.append(row + "\n");
 }
 

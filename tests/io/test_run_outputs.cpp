@@ -125,6 +125,63 @@ TEST(FolderLock, ASecondRunOnTheSameFolderIsRefusedAtOnce) {
     fs::remove_all(dir);
 }
 
+// history.csv's columns belong to the scene (issue 24, item 4): the specimen's length and
+// footprint only where a rigid plane measures them, extensive quantities per metre of thickness in
+// plane strain, the energy error in per cent as the console prints it, a unit on every column of a
+// dimensional quantity.
+TEST(HistoryColumns, BelongToTheSceneAndCarryTheirUnits) {
+    const auto header_and_row = [](const std::string& text) {
+        const Scene scene = parse_scene(text, "columns.toml");
+        Simulation sim(scene, 1);
+        for (int k = 0; k < 5; ++k) sim.step();
+        const fs::path dir = scratch("columns");
+        {
+            HistoryWriter history(dir / "history.csv", sim.totals(), HistoryLayout::of(scene));
+            history.write(sim.totals());
+        }
+        std::istringstream in(read_all(dir / "history.csv"));
+        std::string header, row;
+        std::getline(in, header);
+        std::getline(in, row);
+        fs::remove_all(dir);
+        std::vector<std::string> names, values;
+        for (std::stringstream h(header); std::getline(h, row, ',');) names.push_back(row);
+        std::getline(in.seekg(0), header);
+        std::getline(in, row);
+        for (std::stringstream r(row); std::getline(r, header, ',');) values.push_back(header);
+        return std::make_tuple(names, values, sim.totals().energy_error);
+    };
+    const auto has = [](const std::vector<std::string>& names, const std::string& name) {
+        return std::find(names.begin(), names.end(), name) != names.end();
+    };
+    // The tiny bar on its anvil: a specimen, axisymmetric (ring totals, no per-metre suffix).
+    const auto [names, values, error] = header_and_row(tiny_scene);
+    ASSERT_EQ(names.size(), values.size());
+    for (const char* column : {"length_m", "footprint_diameter_m", "base_height_m", "face_plastic_strain_roughness",
+                               "kinetic_energy_J", "momentum_z_kg_m_s", "anvil_reaction_N", "total_energy_error_percent"}) {
+        EXPECT_TRUE(has(names, column)) << column;
+    }
+    const auto at = [&](const std::string& name) {
+        return std::stod(values[static_cast<std::size_t>(std::find(names.begin(), names.end(), name) - names.begin())]);
+    };
+    EXPECT_NE(error, 0.0);
+    // Written with 7 significant digits: within half a unit of the last.
+    EXPECT_NEAR(at("total_energy_error_percent"), 100.0 * error, 5e-7 * std::abs(100.0 * error));
+    // Without a rigid plane: no specimen columns. In plane strain: per metre of thickness.
+    std::string free_slab = tiny_scene;
+    free_slab.replace(free_slab.find("axisymmetric"), 12, "plane-strain");
+    free_slab.erase(free_slab.find("[[plane]]"), free_slab.find("[stop]") - free_slab.find("[[plane]]"));
+    const auto [slab_names, slab_values, slab_error] = header_and_row(free_slab);
+    for (const char* column : {"length_m", "footprint_diameter_m", "base_height_m", "face_plastic_strain_roughness"}) {
+        EXPECT_FALSE(has(slab_names, column)) << column;
+    }
+    for (const char* column : {"kinetic_energy_J_per_m", "plastic_work_J_per_m", "momentum_x_kg_m_s_per_m", "hourglass_work_J_per_m"}) {
+        EXPECT_TRUE(has(slab_names, column)) << column;
+    }
+    EXPECT_FALSE(has(slab_names, "kinetic_energy_J"));
+    EXPECT_EQ(slab_names.size(), slab_values.size());
+}
+
 TEST(DiskFull, HistoryKeepsWholeLines) {
     const fs::path dir = scratch("history");
     const Scene scene = parse_scene(tiny_scene, "tiny.toml");
@@ -132,7 +189,7 @@ TEST(DiskFull, HistoryKeepsWholeLines) {
     const fs::path file = dir / "history.csv";
     std::string message;
     {
-        HistoryWriter history(file, sim.totals(), 2);
+        HistoryWriter history(file, sim.totals(), HistoryLayout::of(scene));
         const FileSizeLimit limit(3000);  // the header and a few rows
         try {
             for (int k = 0; k < 100; ++k) history.write(sim.totals());

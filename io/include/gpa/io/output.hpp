@@ -92,23 +92,33 @@ private:
     std::filesystem::path path_;
 };
 
-// history.csv: one row per call, with a header naming every column and its unit.
+// Which columns history.csv gives a scene.
+struct HistoryLayout {
+    int dim = 2;             // components of vectors (x, z or x, y, z)
+    bool per_metre = false;  // plane strain: energies, momenta, forces and impulses per metre of thickness (unit suffix _per_m)
+    bool specimen = true;    // a rigid plane to measure a specimen on: length, footprint, base height, face roughness
+    static HistoryLayout of(const Scene& scene);
+};
+
+// history.csv: one row per call, with a header naming every column and its unit (a column without
+// a unit is a count, a strain or a flag). total_energy_error_percent is the energy balance's
+// error in per cent, as the console prints it.
 class HistoryWriter {
 public:
     using Mark = RowFile::Mark;
-    HistoryWriter(const std::filesystem::path& file, const Totals& first, int dim);
+    HistoryWriter(const std::filesystem::path& file, const Totals& first, const HistoryLayout& layout);
     // RowFile::kept_for_resume for history.csv as this run writes it.
-    static std::string kept_for_resume(const std::filesystem::path& file, const Totals& first, int dim, std::size_t last_step,
-                                       std::size_t every, Mark at, const std::string& checkpoint);
+    static std::string kept_for_resume(const std::filesystem::path& file, const Totals& first, const HistoryLayout& layout,
+                                       std::size_t last_step, std::size_t every, Mark at, const std::string& checkpoint);
     // A resumed run: the file rewritten (atomically) to `kept` (kept_for_resume), and appended to.
-    HistoryWriter(const std::filesystem::path& file, const Totals& first, int dim, const std::string& kept);
+    HistoryWriter(const std::filesystem::path& file, const Totals& first, const HistoryLayout& layout, const std::string& kept);
     void write(const Totals& t);
     // The file as it is now (for the checkpoint).
     Mark mark() const { return file_.mark(); }
 
 private:
     RowFile file_;
-    int dim_;
+    HistoryLayout layout_;
     std::size_t planes_;
     std::vector<bool> friction_;  // per plane: it has friction (a friction-work column)
     std::vector<std::array<bool, 3>> regions_;  // the held components of each prescribed-velocity region
