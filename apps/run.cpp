@@ -261,7 +261,10 @@ void check_disk(const Simulation& sim, const SnapshotSchedule& schedule, const f
     // (on resume, one of them is there already).
     const double checkpoint = (kept ? 1.0 : 2.0) * (double(sim.nodes().size()) * bytes_per_node_besides_lists(sim.nodes().dim()) / 2.0 +
                                                     4.0 * double(sim.totals().pairs));
-    const double bytes = snapshots * double(snapshot_bytes) + rows * 400.0 + checkpoint;
+    // A history row is about 400 bytes; a gauge row 16 bytes a column.
+    double row_bytes = 400.0;
+    for (const auto& g : s.gauges) row_bytes += 16.0 * (2.0 + 6.0 * double(g.fields.empty() ? 6 : g.fields.size()));
+    const double bytes = snapshots * double(snapshot_bytes) + rows * row_bytes + checkpoint;
     const double available = double(free_bytes(folder));
     if (bytes > available) {
         throw LimitError(fmt::format("{} need an estimated {} of disk ({:.3g} {}snapshots of {} each{}, the "
@@ -592,8 +595,8 @@ private:
     std::optional<io::HistoryWriter> history_;
     std::optional<io::GaugeWriter> gauges_;  // gauge_<name>.csv, on the history's schedule
     std::size_t last_row_ = 0;  // the step of the last history row
-    io::HistoryWriter::Mark scheduled_rows_;
-    std::vector<io::GaugeWriter::Mark> scheduled_gauge_rows_;  // the gauges' files as of the same row  // history.csv as of its last row on the schedule (steps 0, every, ...)
+    io::HistoryWriter::Mark scheduled_rows_;  // history.csv as of its last row on the schedule (steps 0, every, ...)
+    std::vector<io::GaugeWriter::Mark> scheduled_gauge_rows_;  // the gauges' files as of the same row
 };
 
 int fresh_run(const RunOptions& options) {
@@ -603,6 +606,7 @@ int fresh_run(const RunOptions& options) {
     log_scene_warnings(scene, source.name);
     const fs::path output = options.output.value_or(default_output_folder("runs", scene.name));
     Simulation sim(scene, options.threads, options.memory);  // before the folder: an impossible scene leaves nothing behind
+    for (const auto& spec : scene.gauges) Gauge(spec, scene, sim.nodes(), sim.real_count());  // so is a gauge with no node
     io::RunFolder folder(output, options.overwrite);
     if (!options.quiet) {
         spdlog::info("{}: {} nodes, {} thread{}, output in {}", scene.name.empty() ? "scene" : scene.name, sim.real_count(),
@@ -698,6 +702,9 @@ int check_scene(const fs::path& file, const MemoryLimit& memory) {
     // for its memory, and the user should see why.
     log_scene_warnings(scene, file.string());
     Simulation sim(scene, 1, memory);  // builds the nodes: every check of set-up runs
+    // Each gauge placed as the run will place it (a gauge with no node to read is refused here).
+    std::vector<Gauge> gauges;
+    for (const auto& spec : scene.gauges) gauges.emplace_back(spec, scene, sim.nodes(), sim.real_count());
     fmt::print("{}: OK\n", file.string());
     fmt::print("  {} ({}), {} bod{}, {} real nodes, {} ghost nodes at the start\n", scene.name, name_of(scene.geometry),
                scene.bodies.size(), scene.bodies.size() == 1 ? "y" : "ies", sim.real_count(), sim.totals().ghost_nodes);
@@ -739,9 +746,9 @@ int check_scene(const fs::path& file, const MemoryLimit& memory) {
         fmt::print("  prescribed velocity \"{}\": {} nodes of body \"{}\" at {}{}\n", r.name, sim.totals().regions[k].nodes, r.body, held,
                    r.ramp > 0.0 ? fmt::format(" after a {:.4g} us ramp", r.ramp * 1e6) : std::string());
     }
-    // Each gauge placed as the run will place it (a gauge with no node to read is refused here).
-    for (const auto& spec : scene.gauges) {
-        const Gauge gauge(spec, scene, sim.nodes(), sim.real_count());
+    // The gauges and their nodes.
+    for (const Gauge& gauge : gauges) {
+        const GaugeSpec& spec = gauge.spec();
         const auto& ids = gauge.node_ids();
         const std::string listed = ids.size() <= 8 ? fmt::format("{}", fmt::join(ids, ", "))
                                                    : fmt::format("{}, ... {}", fmt::join(ids.begin(), ids.begin() + 4, ", "), ids.back());

@@ -197,7 +197,9 @@ std::string RowFile::kept_for_resume(const fs::path& file, const std::string& he
         }
     }
     if (old.compare(0, header.size(), header) != 0) {
-        throw OutputError(fmt::format("'{}' does not start with the header this run writes", file.string()));
+        throw OutputError(fmt::format("'{}' does not start with the header this run writes (it was written by another version "
+                                      "of gpa, or changed); {}",
+                                      file.string(), cannot));
     }
     // The rows of the schedule (steps 0, every, 2 every, ...) up to the checkpoint, each once and in
     // order; rows off the schedule (the last one of an interruption) and beyond it are left out.

@@ -87,8 +87,13 @@ grep -q '"status": "finished"' far/summary.json 2> /dev/null || fail "far body: 
 # --- one run per output folder ---------------------------------------------------------------
 # (4000 steps of 15 ns, a snapshot every 5 us: a quarter of a second in a release build.)
 # Two gauges (a point in the middle, the free top face), whose files resume like the history.
-with_gauges=(-e 's/^\[stop\]/[[gauge]]\nname = "middle"\nat = [0, "2 mm"]\nfields = ["velocity", "stress"]\n\n[[gauge]]\nname = "top"\nkind = "free_surface"\nat = [0, "4 mm"]\nnormal = "+z"\nradius = "1 mm"\n\n[stop]/')
+with_gauges=(-e 's/^\[stop\]/[[gauge]]\nname = "middle"\nat = [0, "2 mm"]\nfields = ["velocity", "stress"]\n\n[[gauge]]\nname = "top"\nkind = "free_surface"\nbody = "bar"\nat = [0, "4 mm"]\nnormal = "+z"\nradius = "1 mm"\n\n[stop]/')
 variant long.toml -e 's/^max_steps = 20/max_steps = 4000/' -e 's/^snapshots = 3/snapshot_interval = "5 us"/' "${with_gauges[@]}"
+# A gauge that finds no node is refused before the output folder is made.
+variant lost-gauge.toml -e 's/^\[stop\]/[[gauge]]\nname = "lost"\nat = [0, "100 mm"]\n\n[stop]/'
+expect 2 "a gauge away from the bar" -- "$gpa" run lost-gauge.toml -o lost -q
+says err.txt 'gauge "lost": (x, z) = (0, 100) mm is not in any particle body' "a gauge away from the bar"
+[[ -e lost || -e lost.partial ]] && fail "a refused gauge left an output folder"
 "$gpa" run long.toml -o conc -q --threads 1 > conc-first.out 2> conc-first.err &
 first=$!
 wait_for_lines conc.partial/history.csv 20 || fail "the first run never started"

@@ -80,6 +80,7 @@ fields = ["position", "velocity", "stress", "displacement"]
 [[gauge]]
 name = "top"
 kind = "free_surface"
+body = "bar"
 at = [0, "20 mm"]
 normal = "+z"
 radius = "1 mm"
@@ -173,6 +174,14 @@ fields = ["position", "velocity", "pressure"]
     EXPECT_NEAR(values[1], z / mass, 1e-15);
     EXPECT_NEAR(values[3], vz / mass, 1e-14 * v0);
     EXPECT_NEAR(values[4], p / mass, 1e-12 * std::max(1.0, std::abs(p / mass)));
+    // Read again after the store is reversed: the gauge finds its nodes by id and sums them in
+    // the order of their ids, so the values are the same bit for bit.
+    NodeStore reversed = n;
+    std::vector<NodeIndex> new_to_old(n.size());
+    for (std::size_t i = 0; i < n.size(); ++i) new_to_old[i] = static_cast<NodeIndex>(i < sim.real_count() ? sim.real_count() - 1 - i : i);
+    reversed.permute(new_to_old);
+    ASSERT_NE(reversed.id[0], n.id[0]);
+    EXPECT_EQ(gauge.read(reversed, sim.real_count()), values);
     // The nodes are those within the radius of the point at t = 0.
     for (std::size_t i = 0; i < sim.real_count(); ++i) {
         const double d = std::hypot(n.initial_position[0][i], n.initial_position[1][i] - 5e-3);
@@ -227,22 +236,31 @@ TEST(Gauges, BadGaugesAreRefusedWithTheirNameAndWhy) {
     refused("[[gauge]]\nname = \"a b\"\nat = [0, \"1 mm\"]", "letters, digits, '-' and '_' only");
     refused("[[gauge]]\nname = \"a\"\nat = [0, \"1 mm\"]\n[[gauge]]\nname = \"a\"\nat = [0, \"2 mm\"]", "already used by gauge[0]");
     refused("[[gauge]]\nname = \"a\"", "gauge \"a\" (gauge[0]): missing required key \"at\"");
-    refused("[[gauge]]\nname = \"a\"\nat = [0, \"1 mm\", 0]", "at");
-    refused("[[gauge]]\nname = \"a\"\nat = [0, \"1 kg\"]", "at");
+    refused("[[gauge]]\nname = \"a\"\nat = [0, \"1 mm\", 0]", "gauge \"a\" (gauge[0]).at: expected an array of 2 length values [x, z], got 3 values");
+    refused("[[gauge]]\nname = \"a\"\nat = [0, \"1 kg\"]", "gauge \"a\" (gauge[0]).at[1]: \"1 kg\" is in kg (SI kg), which no scene value is; a length takes");
     refused("[[gauge]]\nname = \"a\"\nat = [0, \"1 mm\"]\nbody = \"rod\"", "body \"rod\" is not a body of the scene");
-    refused("[[gauge]]\nname = \"a\"\nat = [0, \"1 mm\"]\nradius = \"-1 mm\"", "radius");
-    refused("[[gauge]]\nname = \"a\"\nat = [0, \"1 mm\"]\nkind = \"line\"", "\"point\"");
-    refused("[[gauge]]\nname = \"a\"\nat = [0, \"1 mm\"]\nnormal = \"+z\"", "free-surface gauges only");
-    refused("[[gauge]]\nname = \"a\"\nkind = \"free_surface\"\nat = [0, \"20 mm\"]", "normal");
-    refused("[[gauge]]\nname = \"a\"\nkind = \"free_surface\"\nat = [0, \"20 mm\"]\nnormal = \"+y\"", "\"+x\", \"-x\", \"+z\" or \"-z\"");
+    refused("[[gauge]]\nname = \"a\"\nat = [0, \"1 mm\"]\nradius = \"-1 mm\"", "gauge \"a\" (gauge[0]).radius: \"-1 mm\" must not be negative");
+    refused("[[gauge]]\nname = \"a\"\nat = [0, \"1 mm\"]\nkind = \"line\"", "\"line\" is not one of \"point\" or \"free_surface\"");
+    refused("[[gauge]]\nname = \"a\"\nat = [0, \"1 mm\"]\nnormal = \"+z\"", "normal: applies to free-surface gauges only");
+    refused("[[gauge]]\nname = \"a\"\nkind = \"free_surface\"\nbody = \"bar\"\nat = [0, \"20 mm\"]",
+            "missing required key \"normal\"");
+    refused("[[gauge]]\nname = \"a\"\nkind = \"free_surface\"\nbody = \"bar\"\nat = [0, \"20 mm\"]\nnormal = \"+y\"",
+            "\"+x\", \"-x\", \"+z\" or \"-z\"");
+    refused("[[gauge]]\nname = \"a\"\nkind = \"free_surface\"\nat = [0, \"20 mm\"]\nnormal = \"+z\"", "a free-surface gauge names its body");
+    refused("[[gauge]]\nname = \"a\"\nkind = \"free_surface\"\nbody = \"bar\"\nat = [0, \"10 mm\"]\nnormal = \"-x\"",
+            "normal -x points at the axis");
     refused("[[gauge]]\nname = \"a\"\nat = [0, \"1 mm\"]\nfields = [\"speed\"]", "\"speed\" is not a gauge field");
     refused("[[gauge]]\nname = \"a\"\nat = [0, \"1 mm\"]\nfields = []", "a list of field names");
     refused("[[gauge]]\nname = \"a\"\nat = [0, \"1 mm\"]\nfields = [\"pressure\", \"pressure\"]", "pressure is listed twice");
     refused("[[gauge]]\nname = \"a\"\nat = [0, \"1 mm\"]\nfields = [\"normal_velocity\"]", "a point gauge has none");
-    refused("[[gauge]]\nname = \"a\"\nat = [0, \"1 mm\"]\ncolour = 1", "colour");
-    // Rules that need the nodes: nothing within the radius, a free surface away from the face.
+    refused("[[gauge]]\nname = \"a\"\nat = [0, \"1 mm\"]\ncolour = 1", "gauge \"a\" (gauge[0]).colour: unknown key; a gauge takes name, kind, at, body, radius, normal, fields");
+    // Rules that need the nodes: a point away from the body, nothing within the radius, a free
+    // surface away from the face or beside it.
+    refused("[[gauge]]\nname = \"a\"\nat = [0, \"100 mm\"]", "is not in any particle body: the nearest node is");
     refused("[[gauge]]\nname = \"a\"\nat = [\"5 mm\", \"1 mm\"]\nradius = \"0.1 mm\"", "no node of any particle body lies within radius");
-    refused("[[gauge]]\nname = \"a\"\nkind = \"free_surface\"\nat = [0, \"15 mm\"]\nnormal = \"+z\"", "is not on the face");
+    refused("[[gauge]]\nname = \"a\"\nkind = \"free_surface\"\nbody = \"bar\"\nat = [0, \"15 mm\"]\nnormal = \"+z\"", "is not on the face");
+    refused("[[gauge]]\nname = \"a\"\nkind = \"free_surface\"\nbody = \"bar\"\nat = [\"50 mm\", \"20 mm\"]\nnormal = \"+z\"",
+            "is beside body \"bar\"");
 }
 
 }  // namespace

@@ -180,6 +180,14 @@ TEST(HistoryColumns, BelongToTheSceneAndCarryTheirUnits) {
     }
     EXPECT_FALSE(has(slab_names, "kinetic_energy_J"));
     EXPECT_EQ(slab_names.size(), slab_values.size());
+    // A plane-strain slab on its anvil: the specimen columns again, the plane's per metre.
+    std::string slab_on_anvil = tiny_scene;
+    slab_on_anvil.replace(slab_on_anvil.find("axisymmetric"), 12, "plane-strain");
+    const auto [anvil_names, anvil_values, anvil_error] = header_and_row(slab_on_anvil);
+    for (const char* column : {"length_m", "footprint_diameter_m", "anvil_reaction_N_per_m", "anvil_impulse_N_s_per_m"}) {
+        EXPECT_TRUE(has(anvil_names, column)) << column;
+    }
+    EXPECT_FALSE(has(anvil_names, "anvil_reaction_N"));
 }
 
 TEST(DiskFull, HistoryKeepsWholeLines) {

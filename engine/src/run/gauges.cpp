@@ -6,6 +6,7 @@
 
 #include <fmt/format.h>
 
+#include "gpa/engine/bodies.hpp"
 #include "gpa/engine/errors.hpp"
 #include "gpa/engine/node_store.hpp"
 #include "gpa/engine/scene.hpp"
@@ -132,6 +133,17 @@ void validate_gauges(const Scene& scene) {
             throw GaugeError(fmt::format("{}: the scene has no particle body; gauges read particle bodies", label), k);
         }
         if (g.kind == GaugeKind::FreeSurface) {
+            if (g.body.empty()) {
+                throw GaugeError(fmt::format("{}: a free-surface gauge names its body (the face is that body's: a face of one body "
+                                             "may lie under another)",
+                                             label),
+                                 k);
+            }
+            if (scene.geometry == GeometryKind::Axisymmetric && g.normal_axis == 0 && g.normal_sign < 0) {
+                throw GaugeError(fmt::format("{}: normal -x points at the axis of an axisymmetric scene, which is not a free surface",
+                                             label),
+                                 k);
+            }
             if (g.normal_axis < 0 || g.normal_axis >= dim || (g.normal_sign != 1 && g.normal_sign != -1)) {
                 throw GaugeError(fmt::format("{}: a free-surface gauge needs the outward normal of its face, an axis and a sign "
                                              "(for example \"+z\" or \"-x\")",
@@ -163,6 +175,17 @@ Gauge::Gauge(const GaugeSpec& spec, const Scene& scene, const NodeStore& nodes, 
         if (!spec_.body.empty() && scene.bodies[b].name == spec_.body) body = static_cast<int>(b);
     }
     const auto candidate = [&](std::size_t i) { return spec_.body.empty() || nodes.body[i] == body; };
+    // Each particle body's lattice spacing per axis: a node's cell extends half of it either way.
+    std::vector<std::array<double, 3>> spacing(scene.bodies.size(), std::array<double, 3>{0.0, 0.0, 0.0});
+    for (std::size_t b = 0; b < scene.bodies.size(); ++b) {
+        if (scene.bodies[b].discretisation == Discretisation::Particles) spacing[b] = body_lattice(scene, b).spacing;
+    }
+    const auto cell = [&](std::size_t i, int axis) { return spacing[static_cast<std::size_t>(nodes.body[i])][static_cast<std::size_t>(axis)]; };
+    const auto largest_cell = [&](std::size_t i) {
+        double h = 0.0;
+        for (int c = 0; c < dim; ++c) h = std::max(h, cell(i, c));
+        return h;
+    };
     const auto initial = [&](std::size_t i) {
         std::array<double, 3> x{0.0, 0.0, 0.0};
         for (int c = 0; c < dim; ++c) x[c] = nodes.initial_position[c][i];
@@ -193,6 +216,13 @@ Gauge::Gauge(const GaugeSpec& spec, const Scene& scene, const NodeStore& nodes, 
     std::vector<std::size_t> chosen;
     if (spec_.kind == GaugeKind::Point) {
         if (spec_.radius == 0.0) {
+            // The nearest node's cell must hold the point, or nearly (within a cell of its centre).
+            if (std::sqrt(distance2(nearest, -1)) > largest_cell(nearest)) {
+                throw InputError(fmt::format("{}: {} is not in {}: the nearest node is {:.6g} mm away at t = 0, more than a cell "
+                                             "({:.6g} mm); move the point into the body",
+                                             label, format_point(spec_.at, dim), where, std::sqrt(distance2(nearest, -1)) * 1e3,
+                                             largest_cell(nearest) * 1e3));
+            }
             chosen.push_back(nearest);
         } else {
             for (std::size_t i = 0; i < real; ++i) {
@@ -209,6 +239,12 @@ Gauge::Gauge(const GaugeSpec& spec, const Scene& scene, const NodeStore& nodes, 
         // The spot: the nodes within the radius across the normal (0: those as near as the nearest).
         const int a = spec_.normal_axis;
         const double s = spec_.normal_sign;
+        if (spec_.radius == 0.0 && std::sqrt(distance2(nearest, a)) > largest_cell(nearest)) {
+            throw InputError(fmt::format("{}: {} is beside {}: across the normal the nearest node is {:.6g} mm away at t = 0, more "
+                                         "than a cell ({:.6g} mm); move the point onto the face",
+                                         label, format_point(spec_.at, dim), where, std::sqrt(distance2(nearest, a)) * 1e3,
+                                         largest_cell(nearest) * 1e3));
+        }
         const double reach2 = spec_.radius > 0.0 ? spec_.radius * spec_.radius : distance2(nearest, a);
         std::vector<std::size_t> spot;
         for (std::size_t i = 0; i < real; ++i) {
@@ -229,11 +265,11 @@ Gauge::Gauge(const GaugeSpec& spec, const Scene& scene, const NodeStore& nodes, 
             }
         }
         for (const std::size_t i : spot) {
-            if (s * initial(i)[a] >= outermost - 0.5 * nodes.initial_diameter[i]) chosen.push_back(i);
+            if (s * initial(i)[a] >= outermost - 0.5 * cell(i, a)) chosen.push_back(i);
         }
         // The face is half a cell beyond the outermost node; `at` must be on it.
-        const double face = outermost + 0.5 * nodes.initial_diameter[edge];
-        if (std::abs(s * spec_.at[a] - face) > nodes.initial_diameter[edge]) {
+        const double face = outermost + 0.5 * cell(edge, a);
+        if (std::abs(s * spec_.at[a] - face) > cell(edge, a)) {
             throw InputError(fmt::format("{}: {} is not on the face of {} whose outward normal is {}{}: the face there is at {} = "
                                          "{:.6g} mm (the outermost nodes' outer edge at t = 0)",
                                          label, format_point(spec_.at, dim), where, s > 0 ? "+" : "-", axis_name(dim, a),

@@ -16,6 +16,17 @@ public:
     using std::invalid_argument::invalid_argument;
 };
 
+// An input error in one entry of a list of a scene ([[prescribed_velocity]], [[gauge]]): its
+// index says which entry, so that a scene reader can name the line of its table.
+class EntryError : public InputError {
+public:
+    EntryError(const std::string& message, std::size_t index) : InputError(message), index_(index) {}
+    std::size_t index() const { return index_; }
+
+private:
+    std::size_t index_;
+};
+
 // A state the method reached and cannot continue from (a node left its neighbourhood, a
 // non-finite value appeared during a run). A kernel that knows the node and the field at fault
 // names them here too, so that the run's report can add the node's body and position.

@@ -6,13 +6,15 @@
 // A gauge is a set of nodes chosen once, by their positions at t = 0, and followed by their node
 // ids (node_store.hpp) wherever the run moves or reorders them:
 //
-//   point         the node nearest to `at` (ties: the lowest id); with a radius, every node within
-//                 it, its fields averaged with the nodes' masses as weights (a weighted point).
+//   point         the node nearest to `at` (ties: the lowest id), which must be within a cell of
+//                 it; with a radius, every node within it, its fields averaged with the nodes'
+//                 masses as weights (a weighted point).
 //   free surface  a spot on a body's face whose outward normal is `normal` (an axis and a sign):
 //                 the nodes of the outermost row along the normal (within half a cell of the
 //                 outermost node) among those whose distance from `at` across the normal is at
-//                 most `radius` (0: the nodes nearest to `at` across the normal, one column);
-//                 `at` must lie on that face (within a cell of the nodes' outer edge). Its
+//                 most `radius` (0: the nodes nearest to `at` across the normal, one column, within
+//                 a cell of it); `at` must lie on that face (within a cell of the nodes' outer
+//                 edge), and the gauge names its body (a face may lie under another body). Its
 //                 normal_velocity is the mass-weighted mean velocity along the outward normal,
 //                 the free-surface velocity of a plate-impact or spall experiment.
 //
@@ -73,21 +75,16 @@ struct GaugeSpec {
 // surface).
 std::vector<GaugeField> default_gauge_fields(GaugeKind kind);
 
-// An error in one gauge of a scene: its index says which entry, so that a scene reader can name
-// the line of its table.
-class GaugeError : public InputError {
+// An error in one gauge of a scene (its index: which [[gauge]] table).
+class GaugeError : public EntryError {
 public:
-    GaugeError(const std::string& message, std::size_t index) : InputError(message), index_(index) {}
-    std::size_t index() const { return index_; }
-
-private:
-    std::size_t index_;
+    using EntryError::EntryError;
 };
 
 // The rules a gauge must follow before any node exists (validate_scene calls it): a file-safe
-// name unique in the scene, a known particle body, a radius >= 0 and finite, a normal for a free
-// surface only and within the geometry's axes, normal_velocity on free surfaces only, no field
-// twice. Throws GaugeError naming the gauge.
+// name unique in the scene, a known particle body (required for a free surface), a radius >= 0 and
+// finite, a normal for a free surface only, within the geometry's axes and not towards the axis of
+// an axisymmetric scene, normal_velocity on free surfaces only, no field twice. Throws GaugeError naming the gauge.
 void validate_gauges(const Scene& scene);
 
 // One gauge placed on the nodes of a run: the ids of its nodes and how it reads them.
@@ -95,8 +92,8 @@ class Gauge {
 public:
     // Chooses the gauge's nodes among the real nodes [0, real) by their initial positions (so that
     // placing it again on a resumed run chooses the same ones). Throws InputError naming the gauge
-    // when no node qualifies (no node of the body within the radius; a free-surface point that is
-    // not on the body's face).
+    // when no node qualifies (a point more than a cell from every node, no node of the body within
+    // the radius, a free-surface point that is not on the body's face).
     Gauge(const GaugeSpec& spec, const Scene& scene, const NodeStore& nodes, std::size_t real);
 
     const GaugeSpec& spec() const { return spec_; }

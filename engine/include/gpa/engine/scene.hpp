@@ -296,13 +296,9 @@ struct Scene {
 // that a scene reader can name the line): an unknown body, no component, a negative ramp, a region
 // outside the body or holding none of its nodes, two regions sharing a node, a region that would
 // move nodes through a plane they touch.
-class PrescribedVelocityError : public InputError {
+class PrescribedVelocityError : public EntryError {
 public:
-    PrescribedVelocityError(const std::string& message, std::size_t index) : InputError(message), index_(index) {}
-    std::size_t index() const { return index_; }
-
-private:
-    std::size_t index_;
+    using EntryError::EntryError;
 };
 
 void validate_scene(const Scene& scene);
