@@ -142,7 +142,7 @@ FieldChoice parse_field_choice(std::string_view text, GeometryKind geometry) {
 }
 
 std::string_view field_unit(std::string_view name) {
-    static const std::array<std::pair<std::string_view, std::string_view>, 14> units{{
+    static const std::array<std::pair<std::string_view, std::string_view>, 15> units{{
         {"velocity", "m/s"},
         {"force", "N"},
         {"pressure", "Pa"},
@@ -155,6 +155,7 @@ std::string_view field_unit(std::string_view name) {
         {"internal_energy", "J/kg"},
         {"plastic_strain", ""},
         {"damage", ""},
+        {"failed", ""},
         {"volumetric_strain", ""},
         {"connectivity", ""},
     }};

@@ -159,12 +159,15 @@ private:
             while (i < text_.size() && !is_space(text_[i]) && text_[i] != '=' && text_[i] != '>') ++i;
             const std::string key = text_.substr(key_start, i - key_start);
             while (i < text_.size() && is_space(text_[i])) ++i;
-            if (i >= text_.size() || text_[i] != '=') {
+            // The text ends inside the tag: a file cut short, not a malformed attribute.
+            if (i >= text_.size()) fail(file_, fmt::format("the XML element <{}> is not closed (file cut short?)", tag.name));
+            if (text_[i] != '=') {
                 fail(file_, fmt::format("malformed XML in <{}>: attribute '{}' has no value", tag.name, key));
             }
             ++i;
             while (i < text_.size() && is_space(text_[i])) ++i;
-            if (i >= text_.size() || (text_[i] != '"' && text_[i] != '\'')) {
+            if (i >= text_.size()) fail(file_, fmt::format("the XML element <{}> is not closed (file cut short?)", tag.name));
+            if (text_[i] != '"' && text_[i] != '\'') {
                 fail(file_, fmt::format("malformed XML in <{}>: the value of '{}' is not quoted", tag.name, key));
             }
             const char quote = text_[i++];

@@ -1,5 +1,6 @@
 #include "gpa/io/vtk.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -56,7 +57,9 @@ void write_vtp(const std::filesystem::path& path, const NodeStore& nodes, std::s
         {"von_mises_stress", 1, [&](std::size_t i, int) { return von_mises_stress(nodes, i); }},
         {"plastic_strain", 1, [&](std::size_t i, int) { return nodes.plastic_strain[i]; }},
         {"temperature", 1, [&](std::size_t i, int) { return nodes.temperature[i]; }},
-        {"damage", 1, [&](std::size_t i, int) { return nodes.damage[i]; }},
+        // Johnson-Cook damage D in [0, 1]: the model sums it past 1 after failure (1.4 in a spall run),
+        // which would only stretch a colour scale; `failed` below says which nodes have failed.
+        {"damage", 1, [&](std::size_t i, int) { return std::min(nodes.damage[i], 1.0); }},
         {"volumetric_strain", 1, [&](std::size_t i, int) { return nodes.volumetric_strain[i]; }},
         {"diameter", 1, [&](std::size_t i, int) { return nodes.diameter[i]; }},
         {"mass", 1, [&](std::size_t i, int) { return nodes.mass[i]; }},
@@ -72,6 +75,8 @@ void write_vtp(const std::filesystem::path& path, const NodeStore& nodes, std::s
     const std::uint64_t points = data.add_float(count, 3, positions);
     // The node ids (node_store.hpp): the same node in every snapshot, whatever the run's reordering.
     const std::uint64_t ids = data.add_int64(count, [&](std::size_t i) { return static_cast<std::int64_t>(nodes.id[i]); });
+    // 1 where the node has failed (no deviator, no tension), 0 elsewhere.
+    const std::uint64_t failed = data.add_int64(count, [&](std::size_t i) { return static_cast<std::int64_t>(nodes.failed[i] != 0); });
     const std::uint64_t connectivity = data.add_int64(count, [](std::size_t i) { return static_cast<std::int64_t>(i); });
     const std::uint64_t vertex_ends = data.add_int64(count, [](std::size_t i) { return static_cast<std::int64_t>(i + 1); });
 
@@ -87,6 +92,8 @@ void write_vtp(const std::filesystem::path& path, const NodeStore& nodes, std::s
         }
         out << fmt::format("        <DataArray type=\"Int64\" Name=\"id\" NumberOfComponents=\"1\" format=\"appended\" offset=\"{}\"/>\n",
                            ids);
+        out << fmt::format("        <DataArray type=\"Int64\" Name=\"failed\" NumberOfComponents=\"1\" format=\"appended\" offset=\"{}\"/>\n",
+                           failed);
         out << "      </PointData>\n      <Points>\n";
         out << fmt::format("        <DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"appended\" offset=\"{}\"/>\n", points);
         out << "      </Points>\n      <Verts>\n";

@@ -5,6 +5,7 @@
 // PNG decodes (libpng) to the picture drawn.
 
 #include <array>
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -91,7 +92,11 @@ NodeStore sample_nodes(GeometryKind geometry, std::size_t n) {
 TEST(SnapshotReader, PositionsAndFieldsOfParticlesComeBackBitForBit) {
     for (GeometryKind g : {GeometryKind::Axisymmetric, GeometryKind::ThreeD}) {
         const fs::path dir = fresh_dir(std::string("roundtrip_") + (g == GeometryKind::ThreeD ? "3d" : "2d"));
-        const NodeStore nodes = sample_nodes(g, 7);
+        NodeStore nodes = sample_nodes(g, 7);
+        for (std::size_t i = 0; i < 7; ++i) {
+            nodes.damage[i] = 0.3 * static_cast<double>(i);  // past 1 from the fourth node on
+            nodes.failed[i] = nodes.damage[i] >= 1.0 ? 1 : 0;
+        }
         SnapshotSeries series(dir);
         series.write(nodes, nodes.size(), 0.0);
         series.write(nodes, 5, 1.234567891234e-5);  // the first 5 nodes only
@@ -124,7 +129,11 @@ TEST(SnapshotReader, PositionsAndFieldsOfParticlesComeBackBitForBit) {
             }
             EXPECT_EQ(bits(pressure[i]), bits(nodes.pressure[i]));
             EXPECT_EQ(bits(strain[i]), bits(nodes.plastic_strain[i]));
+            // Damage written in [0, 1]; failure as its own integer array.
+            EXPECT_EQ(file.values("damage", DataLocation::Point)[i], std::min(0.3 * static_cast<double>(i), 1.0));
+            EXPECT_EQ(file.values("failed", DataLocation::Point)[i], i >= 4 ? 1.0 : 0.0);
         }
+        ASSERT_NE(file.find("failed", DataLocation::Point), nullptr);
         EXPECT_EQ(VtkFile(index.snapshots[1].files[0]).point_count(), 5u);
         const auto* info = file.find("velocity", DataLocation::Point);
         ASSERT_NE(info, nullptr);
