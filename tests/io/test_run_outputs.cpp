@@ -145,10 +145,9 @@ TEST(HistoryColumns, BelongToTheSceneAndCarryTheirUnits) {
         std::getline(in, row);
         fs::remove_all(dir);
         std::vector<std::string> names, values;
-        for (std::stringstream h(header); std::getline(h, row, ',');) names.push_back(row);
-        std::getline(in.seekg(0), header);
-        std::getline(in, row);
-        for (std::stringstream r(row); std::getline(r, header, ',');) values.push_back(header);
+        std::string cell;
+        for (std::stringstream h(header); std::getline(h, cell, ',');) names.push_back(cell);
+        for (std::stringstream r(row); std::getline(r, cell, ',');) values.push_back(cell);
         return std::make_tuple(names, values, sim.totals().energy_error);
     };
     const auto has = [](const std::vector<std::string>& names, const std::string& name) {
@@ -161,12 +160,14 @@ TEST(HistoryColumns, BelongToTheSceneAndCarryTheirUnits) {
                                "kinetic_energy_J", "momentum_z_kg_m_s", "anvil_reaction_N", "total_energy_error_percent"}) {
         EXPECT_TRUE(has(names, column)) << column;
     }
-    const auto at = [&](const std::string& name) {
-        return std::stod(values[static_cast<std::size_t>(std::find(names.begin(), names.end(), name) - names.begin())]);
+    // Clang before 16 cannot capture a structured binding in a lambda (a C++20 rule): pass them in.
+    const auto value_of = [](const std::vector<std::string>& header, const std::vector<std::string>& row,
+                             const std::string& name) {
+        return std::stod(row[static_cast<std::size_t>(std::find(header.begin(), header.end(), name) - header.begin())]);
     };
     EXPECT_NE(error, 0.0);
     // Written with 7 significant digits: within half a unit of the last.
-    EXPECT_NEAR(at("total_energy_error_percent"), 100.0 * error, 5e-7 * std::abs(100.0 * error));
+    EXPECT_NEAR(value_of(names, values, "total_energy_error_percent"), 100.0 * error, 5e-7 * std::abs(100.0 * error));
     // Without a rigid plane: no specimen columns. In plane strain: per metre of thickness.
     std::string free_slab = tiny_scene;
     free_slab.replace(free_slab.find("axisymmetric"), 12, "plane-strain");
