@@ -149,7 +149,7 @@ void print_listing(const io::SnapshotIndex& series, const io::LoadedSnapshot& ch
     fmt::print("  {:<20} {:>10}  {:<36} {:>12} {:>12}\n", "name", "components", "where", "min", "max");
     for (const auto& f : io::list_fields(chosen)) {
         const std::string unit(io::field_unit(f.name));
-        const std::string what = f.components > 1 ? " (magnitude)" : "";
+        const std::string what = f.components == 6 ? " (every component)" : f.components > 1 ? " (magnitude)" : "";
         fmt::print("  {:<20} {:>10}  {:<36} {:>12} {:>12}{}\n", f.name, f.components, f.where, io::format_quantity(f.min, unit),
                    io::format_quantity(f.max, unit), what);
     }

@@ -110,7 +110,7 @@ private:
 // A write that failed is reported by the next call (write, write_marked or wait).
 class SnapshotWriter {
 public:
-    explicit SnapshotWriter(fs::path folder) : series_(std::move(folder)) {}
+    SnapshotWriter(fs::path folder, SnapshotFormat format) : series_(std::move(folder), "particles", std::move(format)) {}
     ~SnapshotWriter() {
         try {
             wait();
@@ -350,7 +350,7 @@ class Runner {
 public:
     Runner(const RunOptions& options, Simulation& sim, io::RunFolder& folder, SceneSource source, RunState state)
         : options_(options), sim_(sim), folder_(folder), source_(std::move(source)), state_(std::move(state)),
-          fingerprint_(io::scene_fingerprint(source_.text)), schedule_(sim.scene()), snapshots_(folder.partial()) {}
+          fingerprint_(io::scene_fingerprint(source_.text)), schedule_(sim.scene()), snapshots_(folder.partial(), sim.scene().output.snapshot_format) {}
 
     // A fresh run: the scene's copy, the history's header, the snapshot at t = 0, the disk check.
     void start() {

@@ -11,6 +11,7 @@ packages=(
   libcli11-dev libtomlplusplus-dev nlohmann-json3-dev
   libpng-dev   # gpa render: PNG pictures of snapshots
   libudunits2-dev   # tests only: the unit reader checked against UDUNITS-2's database
+  python3-vtk9   # tests only: snapshots read by VTK's own readers (tests/io/vtk_round_trip.py)
   clang libclang-rt-14-dev llvm   # scripts/sanitize.sh: sanitizers, libFuzzer, llvm-symbolizer
 )
 if [[ "${1:-}" == "--with-peers" ]]; then

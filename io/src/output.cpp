@@ -388,11 +388,12 @@ std::vector<GaugeWriter::Mark> GaugeWriter::marks() const {
     return out;
 }
 
-SnapshotSeries::SnapshotSeries(fs::path folder, std::string stem) : folder_(std::move(folder)), stem_(std::move(stem)) {}
+SnapshotSeries::SnapshotSeries(fs::path folder, std::string stem, SnapshotFormat format)
+    : folder_(std::move(folder)), stem_(std::move(stem)), format_(std::move(format)) {}
 
 std::string SnapshotSeries::write(const NodeStore& nodes, std::size_t count, double time) {
     const std::string name = fmt::format("{}_{:05d}.vtp", stem_, scheduled_);
-    write_vtp(folder_ / name, nodes, count);
+    write_vtp(folder_ / name, nodes, count, format_);
     entries_.push_back({time, name});
     ++scheduled_;
     write_pvd(folder_ / (stem_ + ".pvd"), entries_);
@@ -420,12 +421,12 @@ std::vector<std::string> SnapshotSeries::write_parts(const Snapshot& snapshot, c
     };
     if (snapshot.particles.size() > 0 || !snapshot.elements) {
         const std::string name = fmt::format("{}_{}.vtp", stem_, suffix);
-        write_vtp(folder_ / name, snapshot.particles, snapshot.particles.size());
+        write_vtp(folder_ / name, snapshot.particles, snapshot.particles.size(), format_);
         add(name);
     }
     if (snapshot.elements) {
         const std::string name = fmt::format("elements_{}.vtu", suffix);
-        write_vtu(folder_ / name, *snapshot.elements);
+        write_vtu(folder_ / name, *snapshot.elements, format_);
         add(name);
     }
     write_pvd(folder_ / (stem_ + ".pvd"), entries_);

@@ -127,25 +127,50 @@ FieldChoice parse_field_choice(std::string_view text, GeometryKind geometry) {
         c.label = "|" + c.name + "|";
         return c;
     }
+    // A symmetric tensor (the stress) is stored as VTK's XX, YY, ZZ, XY, YZ, XZ; 2D runs as (x, z,
+    // out of plane), so that their xx, zz, out-of-plane and xz are components 0, 1, 2 and 3
+    // (docs/outputs.md). The out-of-plane component is the hoop stress of an axisymmetric run.
+    const std::string out_of_plane = geometry == GeometryKind::Axisymmetric ? "hoop" : "yy";
     if (part == "x") {
         c.component = 0;
     } else if (part == "y" && three_d) {
         c.component = 1;
     } else if (part == "z") {
         c.component = three_d ? 2 : 1;  // 2D vectors are stored as (x, z, 0)
+    } else if (part == "xx") {
+        c.component = 0;
+        c.tensor = true;
+    } else if (part == (three_d ? "yy" : "zz")) {
+        c.component = 1;
+        c.tensor = true;
+    } else if (part == (three_d ? "zz" : out_of_plane)) {
+        c.component = 2;
+        c.tensor = true;
+    } else if (three_d && (part == "xy" || part == "yz" || part == "xz")) {
+        c.component = part == "xy" ? 3 : part == "yz" ? 4 : 5;
+        c.tensor = true;
+    } else if (!three_d && part == "xz") {
+        c.component = 3;
+        c.tensor = true;
     } else {
-        throw InputError(fmt::format("--field '{}': '{}' is not a component; {} runs have {}, or magnitude", text, part,
-                                     name_of(geometry), three_d ? "x, y, z" : "x and z"));
+        throw InputError(fmt::format("--field '{}': '{}' is not a component; {} runs have {} for vectors, {} for tensors, "
+                                     "or magnitude",
+                                     text, part, name_of(geometry), three_d ? "x, y, z" : "x and z",
+                                     three_d ? "xx, yy, zz, xy, yz, xz" : fmt::format("xx, zz, {}, xz", out_of_plane)));
     }
     c.label = c.name + ":" + std::string(part);
     return c;
 }
 
 std::string_view field_unit(std::string_view name) {
-    static const std::array<std::pair<std::string_view, std::string_view>, 15> units{{
+    static const std::array<std::pair<std::string_view, std::string_view>, 19> units{{
         {"velocity", "m/s"},
         {"force", "N"},
         {"pressure", "Pa"},
+        {"stress", "Pa"},
+        {"displacement", "m"},
+        {"initial_position", "m"},
+        {"plastic_work", "J/kg"},
         {"von_mises_stress", "Pa"},
         {"viscous_pressure", "Pa"},
         {"temperature", "K"},
@@ -299,7 +324,9 @@ std::vector<FieldSummary> list_fields(const LoadedSnapshot& snapshot) {
             } else {
                 it->where += ", " + where;
             }
-            for (double v : reduce(part.values(info.name, info.location), info.components, std::nullopt)) {
+            // A tensor (6 components): the range over its components; a vector: of its magnitude.
+            const std::vector<double> all = part.values(info.name, info.location);
+            for (double v : info.components == 6 ? all : reduce(all, info.components, std::nullopt)) {
                 if (!std::isfinite(v)) continue;
                 it->min = std::min(it->min, v);
                 it->max = std::max(it->max, v);
@@ -347,6 +374,16 @@ std::optional<PartField> part_field(const VtkFile& f, const FieldChoice& choice)
             if (choice.component && *choice.component >= info->components) {
                 throw InputError(fmt::format("--field {}: {} has {} components in {}", choice.label, choice.name,
                                              info->components, f.path().filename().string()));
+            }
+            const bool tensor = info->components == 6;
+            if (choice.component && choice.tensor != tensor) {
+                throw InputError(fmt::format("--field {}: {} is a {}; name a {} component", choice.label, choice.name,
+                                             tensor ? "tensor" : "vector", tensor ? "tensor's (xx, ...)" : "vector's (x, ...)"));
+            }
+            if (!choice.component && tensor) {
+                throw InputError(fmt::format("--field {}: {} is a tensor: name a component ({}:xx, ...; docs/render.md lists them), or "
+                                             "draw its equivalent, von_mises_stress",
+                                             choice.label, choice.name, choice.name));
             }
             return PartField{l, reduce(f.values(choice.name, l), info->components, choice.component)};
         }

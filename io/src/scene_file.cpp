@@ -41,7 +41,7 @@ const std::vector<std::string_view> gauge_keys{"name", "kind", "at", "body", "ra
 const std::vector<std::string_view> prescribed_keys{"name", "body", "region", "velocity", "ramp"};
 const std::vector<std::string_view> region_keys{"box", "above", "below", "beyond_radius", "within_radius"};
 const std::vector<std::string_view> stop_keys{"end_time", "kinetic_energy_fraction", "max_steps", "energy_error"};
-const std::vector<std::string_view> output_keys{"snapshots", "snapshot_interval", "history_every", "checkpoint_every",
+const std::vector<std::string_view> output_keys{"snapshots", "snapshot_interval", "history_every", "checkpoint_every", "fields", "precision",
                                                 "peak_radius"};
 
 const Choices<ConnectivityMode> connectivity_words{
@@ -591,6 +591,41 @@ OutputOptions read_output(const Reporter& reporter, const toml::table& table) {
         }
     }
     if (const auto v = r.quantity("peak_radius", D::Length, Limit::Positive)) o.peak_radius = *v;
+    // fields: the snapshot arrays, in the order written; "all" stands for every field.
+    if (const toml::node* fields = r.find("fields")) {
+        const auto* list = fields->as_array();
+        std::string known = "\"all\"";
+        for (const SnapshotField f : all_snapshot_fields()) known += fmt::format(", \"{}\"", name_of(f));
+        if (!list) {
+            r.fail_at("fields", fmt::format("expected a list of field names (an empty list for positions and ids alone), got {}",
+                                            as_written(*fields)));
+        }
+        o.snapshot_format.fields.clear();
+        for (std::size_t k = 0; k < list->size(); ++k) {
+            const auto* word = (*list)[k].as_string();
+            std::vector<SnapshotField> named;
+            SnapshotField f{};
+            if (word && word->get() == "all") {
+                named = all_snapshot_fields();
+            } else if (word && snapshot_field_of(word->get(), f)) {
+                named = {f};
+            } else {
+                r.fail_at("fields", fmt::format("{} is not a snapshot field; the fields are {} (id and position are always written)",
+                                                as_written((*list)[k]), known));
+            }
+            for (const SnapshotField n : named) {
+                const auto& chosen = o.snapshot_format.fields;
+                if (std::find(chosen.begin(), chosen.end(), n) != chosen.end()) {
+                    r.fail_at("fields", fmt::format("\"{}\" is named twice", name_of(n)));
+                }
+                o.snapshot_format.fields.push_back(n);
+            }
+        }
+    }
+    if (const auto p = r.choice<SnapshotPrecision>("precision", {{"float64", SnapshotPrecision::Float64},
+                                                                  {"float32", SnapshotPrecision::Float32}})) {
+        o.snapshot_format.precision = *p;
+    }
     return o;
 }
 

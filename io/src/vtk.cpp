@@ -33,11 +33,8 @@ double von_mises_stress(const NodeStore& nodes, std::size_t i) {
 
 namespace {
 
-struct Array {
-    std::string name;
-    int components;
-    std::function<double(std::size_t, int)> value;
-};
+using detail::AppendedBlocks;
+using Declared = AppendedBlocks::Declared;
 
 // Maps a node vector field to three VTK components: 2D (x, z) -> (x, z, 0).
 std::function<double(std::size_t, int)> vector_field(const NodeStore& nodes, const std::array<std::vector<double>, 3>& f) {
@@ -45,40 +42,95 @@ std::function<double(std::size_t, int)> vector_field(const NodeStore& nodes, con
     return [&f, dim](std::size_t i, int c) { return c < dim ? f[c][i] : 0.0; };
 }
 
+// The Cauchy stress s - P I of node i as a VTK symmetric tensor, components XX, YY, ZZ, XY, YZ, XZ
+// (the order ParaView reads a 6-component array in). 2D nodes are drawn in the X-Y plane as
+// (x, z), so X = x, Y = z and Z is the out-of-plane direction (hoop in axisymmetric geometry);
+// the stored order is that of geometry.hpp.
+double vtk_stress(const NodeStore& nodes, std::size_t i, int c) {
+    const auto& s = nodes.deviatoric_stress;
+    const double p = nodes.pressure[i];
+    if (nodes.dim() == 2) {
+        switch (c) {
+            case 0: return s[0][i] - p;  // xx
+            case 1: return s[1][i] - p;  // zz
+            case 2: return s[3][i] - p;  // out of plane
+            case 3: return s[2][i];      // xz
+            default: return 0.0;         // the out-of-plane shears vanish
+        }
+    }
+    switch (c) {
+        case 0: return s[0][i] - p;  // xx
+        case 1: return s[1][i] - p;  // yy
+        case 2: return s[2][i] - p;  // zz
+        case 3: return s[5][i];      // xy
+        case 4: return s[3][i];      // yz
+        default: return s[4][i];     // xz
+    }
+}
+
 }  // namespace
 
-void write_vtp(const std::filesystem::path& path, const NodeStore& nodes, std::size_t count) {
+void write_vtp(const std::filesystem::path& path, const NodeStore& nodes, std::size_t count, const SnapshotFormat& format) {
     if (count > nodes.size()) throw std::invalid_argument(fmt::format("write_vtp: {} of {} nodes", count, nodes.size()));
-    std::vector<Array> arrays{
-        {"velocity", 3, vector_field(nodes, nodes.velocity)},
-        {"force", 3, vector_field(nodes, nodes.force)},
-        {"alpha", 3, vector_field(nodes, nodes.alpha)},
-        {"pressure", 1, [&](std::size_t i, int) { return nodes.pressure[i]; }},
-        {"von_mises_stress", 1, [&](std::size_t i, int) { return von_mises_stress(nodes, i); }},
-        {"plastic_strain", 1, [&](std::size_t i, int) { return nodes.plastic_strain[i]; }},
-        {"temperature", 1, [&](std::size_t i, int) { return nodes.temperature[i]; }},
-        // Johnson-Cook damage D in [0, 1]: the model sums it past 1 after failure (1.4 in a spall run),
-        // which would only stretch a colour scale; `failed` below says which nodes have failed.
-        {"damage", 1, [&](std::size_t i, int) { return std::min(nodes.damage[i], 1.0); }},
-        {"volumetric_strain", 1, [&](std::size_t i, int) { return nodes.volumetric_strain[i]; }},
-        {"diameter", 1, [&](std::size_t i, int) { return nodes.diameter[i]; }},
-        {"mass", 1, [&](std::size_t i, int) { return nodes.mass[i]; }},
-        {"connectivity", 1, [&](std::size_t i, int) { return nodes.connectivity[i] == Connectivity::Variable ? 1.0 : 0.0; }},
-        {"body", 1, [&](std::size_t i, int) { return static_cast<double>(nodes.body[i]); }},
-        {"material", 1, [&](std::size_t i, int) { return static_cast<double>(nodes.material[i]); }},
+    const bool float32 = format.precision == SnapshotPrecision::Float32;
+    const char* float_type = float32 ? "Float32" : "Float64";
+    AppendedBlocks data;
+    std::vector<Declared> arrays;
+    const auto floats = [&](SnapshotField f, int components, std::function<double(std::size_t, int)> value) {
+        arrays.push_back({std::string(name_of(f)), float_type, components, data.add_float(count, components, std::move(value), float32)});
     };
-    const auto positions = vector_field(nodes, nodes.position);
-
-    detail::AppendedBlocks data;
-    std::vector<std::uint64_t> offsets;
-    for (const auto& a : arrays) offsets.push_back(data.add_float(count, a.components, a.value));
-    const std::uint64_t points = data.add_float(count, 3, positions);
+    const auto scalar = [&](SnapshotField f, const std::vector<double>& v) {
+        floats(f, 1, [&v](std::size_t i, int) { return v[i]; });
+    };
+    for (const SnapshotField f : format.fields) {
+        switch (f) {
+            case SnapshotField::Velocity: floats(f, 3, vector_field(nodes, nodes.velocity)); break;
+            case SnapshotField::Force: floats(f, 3, vector_field(nodes, nodes.force)); break;
+            case SnapshotField::Alpha: floats(f, 3, vector_field(nodes, nodes.alpha)); break;
+            case SnapshotField::Pressure: scalar(f, nodes.pressure); break;
+            case SnapshotField::ViscousPressure: scalar(f, nodes.viscous_pressure); break;
+            case SnapshotField::VonMisesStress: floats(f, 1, [&](std::size_t i, int) { return von_mises_stress(nodes, i); }); break;
+            case SnapshotField::Stress: floats(f, 6, [&](std::size_t i, int c) { return vtk_stress(nodes, i, c); }); break;
+            case SnapshotField::PlasticStrain: scalar(f, nodes.plastic_strain); break;
+            case SnapshotField::PlasticWork: scalar(f, nodes.plastic_work); break;
+            case SnapshotField::Temperature: scalar(f, nodes.temperature); break;
+            // Johnson-Cook damage D in [0, 1]: the model sums it past 1 after failure (1.4 in a spall
+            // run), which would only stretch a colour scale; `failed` says which nodes have failed.
+            case SnapshotField::Damage: floats(f, 1, [&](std::size_t i, int) { return std::min(nodes.damage[i], 1.0); }); break;
+            case SnapshotField::Failed:
+                arrays.push_back({"failed", "UInt8", 1,
+                                  data.add_uint8(count, [&](std::size_t i) { return static_cast<std::uint8_t>(nodes.failed[i] != 0); })});
+                break;
+            case SnapshotField::VolumetricStrain: scalar(f, nodes.volumetric_strain); break;
+            case SnapshotField::Density: floats(f, 1, [&](std::size_t i, int) { return nodes.mass[i] / nodes.volume[i]; }); break;
+            case SnapshotField::InternalEnergy: scalar(f, nodes.internal_energy); break;
+            case SnapshotField::Displacement:
+                floats(f, 3, [&](std::size_t i, int c) {
+                    return c < nodes.dim() ? nodes.position[c][i] - nodes.initial_position[c][i] : 0.0;
+                });
+                break;
+            case SnapshotField::InitialPosition: floats(f, 3, vector_field(nodes, nodes.initial_position)); break;
+            case SnapshotField::Diameter: scalar(f, nodes.diameter); break;
+            case SnapshotField::Mass: scalar(f, nodes.mass); break;
+            case SnapshotField::Connectivity:
+                arrays.push_back({"connectivity", "UInt8", 1, data.add_uint8(count, [&](std::size_t i) {
+                                      return static_cast<std::uint8_t>(nodes.connectivity[i] == Connectivity::Variable);
+                                  })});
+                break;
+            case SnapshotField::Body:
+                arrays.push_back({"body", "Int32", 1, data.add_int32(count, [&](std::size_t i) { return nodes.body[i]; })});
+                break;
+            case SnapshotField::Material:
+                arrays.push_back({"material", "Int32", 1, data.add_int32(count, [&](std::size_t i) { return nodes.material[i]; })});
+                break;
+        }
+    }
     // The node ids (node_store.hpp): the same node in every snapshot, whatever the run's reordering.
-    const std::uint64_t ids = data.add_int64(count, [&](std::size_t i) { return static_cast<std::int64_t>(nodes.id[i]); });
-    // 1 where the node has failed (no deviator, no tension), 0 elsewhere.
-    const std::uint64_t failed = data.add_int64(count, [&](std::size_t i) { return static_cast<std::int64_t>(nodes.failed[i] != 0); });
-    const std::uint64_t connectivity = data.add_int64(count, [](std::size_t i) { return static_cast<std::int64_t>(i); });
-    const std::uint64_t vertex_ends = data.add_int64(count, [](std::size_t i) { return static_cast<std::int64_t>(i + 1); });
+    arrays.push_back({"id", "Int64", 1, data.add_int64(count, [&](std::size_t i) { return static_cast<std::int64_t>(nodes.id[i]); })});
+    const std::vector<Declared> points{{"", float_type, 3, data.add_float(count, 3, vector_field(nodes, nodes.position), float32)}};
+    const std::vector<Declared> verts{
+        {"connectivity", "Int64", 1, data.add_int64(count, [](std::size_t i) { return static_cast<std::int64_t>(i); })},
+        {"offsets", "Int64", 1, data.add_int64(count, [](std::size_t i) { return static_cast<std::int64_t>(i + 1); })}};
 
     write_file_atomically(path, [&](std::ofstream& out) {
         out << "<?xml version=\"1.0\"?>\n"
@@ -86,19 +138,11 @@ void write_vtp(const std::filesystem::path& path, const NodeStore& nodes, std::s
             << "  <PolyData>\n"
             << fmt::format("    <Piece NumberOfPoints=\"{}\" NumberOfVerts=\"{}\">\n", count, count);
         out << "      <PointData>\n";
-        for (std::size_t k = 0; k < arrays.size(); ++k) {
-            out << fmt::format("        <DataArray type=\"Float64\" Name=\"{}\" NumberOfComponents=\"{}\" format=\"appended\" offset=\"{}\"/>\n",
-                               arrays[k].name, arrays[k].components, offsets[k]);
-        }
-        out << fmt::format("        <DataArray type=\"Int64\" Name=\"id\" NumberOfComponents=\"1\" format=\"appended\" offset=\"{}\"/>\n",
-                           ids);
-        out << fmt::format("        <DataArray type=\"Int64\" Name=\"failed\" NumberOfComponents=\"1\" format=\"appended\" offset=\"{}\"/>\n",
-                           failed);
+        AppendedBlocks::write_tags(out, "        ", arrays);
         out << "      </PointData>\n      <Points>\n";
-        out << fmt::format("        <DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"appended\" offset=\"{}\"/>\n", points);
+        AppendedBlocks::write_tags(out, "        ", points);
         out << "      </Points>\n      <Verts>\n";
-        out << fmt::format("        <DataArray type=\"Int64\" Name=\"connectivity\" format=\"appended\" offset=\"{}\"/>\n", connectivity);
-        out << fmt::format("        <DataArray type=\"Int64\" Name=\"offsets\" format=\"appended\" offset=\"{}\"/>\n", vertex_ends);
+        AppendedBlocks::write_tags(out, "        ", verts);
         out << "      </Verts>\n    </Piece>\n  </PolyData>\n  <AppendedData encoding=\"raw\">\n   _";
         data.write(out);
         out << "\n  </AppendedData>\n</VTKFile>\n";

@@ -7,18 +7,33 @@
 #include <cstring>
 #include <fstream>
 #include <functional>
+#include <string>
 #include <vector>
 
 namespace gpa::io::detail {
 
 class AppendedBlocks {
 public:
-    // A Float64 array of `components` values for each of `count` entries; returns its offset in
-    // the appended section (the `offset` attribute of its DataArray).
-    std::uint64_t add_float(std::size_t count, int components, std::function<double(std::size_t, int)> value) {
+    // A Float64 array of `components` values for each of `count` entries, or Float32 (each value
+    // rounded to the nearest float) with `float32`; returns its offset in the appended section (the
+    // `offset` attribute of its DataArray).
+    std::uint64_t add_float(std::size_t count, int components, std::function<double(std::size_t, int)> value, bool float32 = false) {
+        if (float32) {
+            return add(count, components, 4, [value = std::move(value)](std::size_t i, int c, char* out) {
+                const float v = static_cast<float>(value(i, c));
+                std::memcpy(out, &v, 4);
+            });
+        }
         return add(count, components, 8, [value = std::move(value)](std::size_t i, int c, char* out) {
             const double v = value(i, c);
             std::memcpy(out, &v, 8);
+        });
+    }
+    // An Int32 array (body and material indices).
+    std::uint64_t add_int32(std::size_t count, std::function<std::int32_t(std::size_t)> value) {
+        return add(count, 1, 4, [value = std::move(value)](std::size_t i, int, char* out) {
+            const std::int32_t v = value(i);
+            std::memcpy(out, &v, 4);
         });
     }
     // An Int64 array (connectivity, offsets).
@@ -28,7 +43,7 @@ public:
             std::memcpy(out, &v, 8);
         });
     }
-    // A UInt8 array (cell types).
+    // A UInt8 array (cell types, flags).
     std::uint64_t add_uint8(std::size_t count, std::function<std::uint8_t(std::size_t)> value) {
         return add(count, 1, 1, [value = std::move(value)](std::size_t i, int, char* out) { *out = static_cast<char>(value(i)); });
     }
@@ -53,6 +68,21 @@ public:
                 if (buffer.size() >= (std::size_t{1} << 20)) flush();
             }
             flush();
+        }
+    }
+
+    // The <DataArray> tags of arrays declared here, one per line at `indent`.
+    struct Declared {
+        std::string name;  // empty: no Name attribute (the Points array)
+        const char* type;  // "Float64", "Float32", "Int64", "Int32", "UInt8"
+        int components;
+        std::uint64_t offset;
+    };
+    static void write_tags(std::ofstream& out, const char* indent, const std::vector<Declared>& arrays) {
+        for (const Declared& a : arrays) {
+            out << indent << "<DataArray type=\"" << a.type << '"';
+            if (!a.name.empty()) out << " Name=\"" << a.name << '"';
+            out << " NumberOfComponents=\"" << a.components << "\" format=\"appended\" offset=\"" << a.offset << "\"/>\n";
         }
     }
 

@@ -573,6 +573,46 @@ TEST(Render, VectorFieldsByMagnitudeOrComponent) {
     EXPECT_FALSE(parse_field_choice("velocity:magnitude", GeometryKind::ThreeD).component);
 }
 
+TEST(Render, TensorFieldsByComponentInTheStoredOrder) {
+    // The snapshot's stress is XX, YY, ZZ, XY, YZ, XZ; 2D runs store (x, z, out of plane).
+    NodeStore n = three_nodes();
+    n.pressure = {0.0, 0.0, 0.0};
+    n.deviatoric_stress[2] = {1.0, 2.0, 3.0};  // xz (2D order: xx, zz, xz, out of plane)
+    n.deviatoric_stress[3] = {-5.0, 7.0, 6.0};  // out of plane
+    const LoadedSnapshot s = snapshot_of("tensor", n);
+    RenderOptions o;
+    o.field = "stress:xz";
+    const Picture xz = render_snapshot(s, GeometryKind::PlaneStrain, o);
+    EXPECT_EQ(xz.range_min, 1.0);
+    EXPECT_EQ(xz.range_max, 3.0);
+    o.field = "stress:yy";  // plane strain: the out-of-plane stress
+    const Picture yy = render_snapshot(s, GeometryKind::PlaneStrain, o);
+    EXPECT_EQ(yy.range_min, -5.0);
+    EXPECT_EQ(yy.range_max, 7.0);
+    o.field = "stress:hoop";
+    EXPECT_EQ(render_snapshot(s, GeometryKind::Axisymmetric, o).range_max, 7.0);
+    const std::vector<std::pair<std::string, int>> three_d{{"xx", 0}, {"yy", 1}, {"zz", 2}, {"xy", 3}, {"yz", 4}, {"xz", 5}};
+    for (const auto& [part, index] : three_d) {
+        const FieldChoice c = parse_field_choice("stress:" + part, GeometryKind::ThreeD);
+        EXPECT_EQ(c.component, index) << part;
+        EXPECT_TRUE(c.tensor) << part;
+    }
+    EXPECT_EQ(parse_field_choice("stress:zz", GeometryKind::Axisymmetric).component, 1);
+    EXPECT_EQ(parse_field_choice("stress:xz", GeometryKind::PlaneStrain).component, 3);
+    // The whole tensor, a vector's component of it, a tensor's of a vector, and components of
+    // another geometry are refused, naming what to write instead.
+    o.field = "stress";
+    EXPECT_TRUE(contains(error_of([&] { render_snapshot(s, GeometryKind::PlaneStrain, o); }), "von_mises_stress"));
+    o.field = "stress:x";
+    EXPECT_TRUE(contains(error_of([&] { render_snapshot(s, GeometryKind::PlaneStrain, o); }), "is a tensor"));
+    o.field = "velocity:xx";
+    EXPECT_TRUE(contains(error_of([&] { render_snapshot(s, GeometryKind::PlaneStrain, o); }), "is a vector"));
+    o.field = "stress:hoop";
+    EXPECT_TRUE(contains(error_of([&] { render_snapshot(s, GeometryKind::PlaneStrain, o); }), "xx, zz, yy, xz"));
+    o.field = "stress:yz";
+    EXPECT_TRUE(contains(error_of([&] { render_snapshot(s, GeometryKind::Axisymmetric, o); }), "xx, zz, hoop, xz"));
+}
+
 TEST(Render, ElementCellsAreFilledWithTheirCellValues) {
     const fs::path dir = fresh_dir("element_picture");
     Snapshot snapshot;

@@ -105,9 +105,18 @@ TEST(SceneFormatDoc, DefaultsAreThoseOfSceneHpp) {
     EXPECT_EQ(o.peak_radius, 0.0);
     expect_word(doc, "peak_radius", " twice the first body's spacing as written ");  // a cell without a `value`: as written
 
-    // The table's solver options, 4 stop criteria, 5 output options, and no row for an option
+    // fields: "every field but `initial_position` and `plastic_work`" (the first quoted word is
+    // what the reader sees here), and those two are what the default leaves out.
+    expect_word(doc, "fields", "initial_position");
+    std::vector<SnapshotField> all_but_two = all_snapshot_fields();
+    std::erase(all_but_two, SnapshotField::InitialPosition);
+    std::erase(all_but_two, SnapshotField::PlasticWork);
+    EXPECT_EQ(o.snapshot_format.fields, all_but_two);
+    expect_word(doc, "precision", o.snapshot_format.precision == SnapshotPrecision::Float64 ? "\"float64\"" : "\"float32\"");
+
+    // The table's solver options, 4 stop criteria, 7 output options, and no row for an option
     // that does not exist.
-    EXPECT_EQ(doc.size(), solver_option_table().size() + 4u + 5u) << "rows in [solver], [stop] and [output] of docs/scene-format.md";
+    EXPECT_EQ(doc.size(), solver_option_table().size() + 4u + 7u) << "rows in [solver], [stop] and [output] of docs/scene-format.md";
 }
 
 // The type column of a [solver] row says what the table's row takes: its words (each quoted, no

@@ -380,7 +380,8 @@ std::vector<double> Gauge::read(const NodeStore& nodes, std::size_t real) {
             case GaugeField::Temperature: out.push_back(mean([&](std::size_t i) { return nodes.temperature[i]; })); break;
             case GaugeField::Density: out.push_back(mean([&](std::size_t i) { return nodes.mass[i] / nodes.volume[i]; })); break;
             case GaugeField::InternalEnergy: out.push_back(mean([&](std::size_t i) { return nodes.internal_energy[i]; })); break;
-            case GaugeField::Damage: out.push_back(mean([&](std::size_t i) { return nodes.damage[i]; })); break;
+            // D in [0, 1], as the snapshots write it (the model sums it past 1 after failure).
+            case GaugeField::Damage: out.push_back(mean([&](std::size_t i) { return std::min(nodes.damage[i], 1.0); })); break;
             case GaugeField::VolumetricStrain: out.push_back(mean([&](std::size_t i) { return nodes.volumetric_strain[i]; })); break;
         }
     }

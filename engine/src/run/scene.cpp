@@ -435,6 +435,19 @@ void check_output(const OutputOptions& o) {
     if (!(o.checkpoint_every_seconds >= 0.0 && finite(o.checkpoint_every_seconds))) {
         fail(fmt::format("output.checkpoint_every = {} s must be a finite wall-clock time >= 0", o.checkpoint_every_seconds));
     }
+    const auto& fields = o.snapshot_format.fields;
+    const std::vector<SnapshotField> all = all_snapshot_fields();
+    for (std::size_t k = 0; k < fields.size(); ++k) {
+        if (std::find(all.begin(), all.end(), fields[k]) == all.end()) {
+            fail(fmt::format("output.fields[{}] = {} is not a snapshot field", k, static_cast<int>(fields[k])));
+        }
+        if (std::find(fields.begin(), fields.begin() + static_cast<std::ptrdiff_t>(k), fields[k]) != fields.begin() + static_cast<std::ptrdiff_t>(k)) {
+            fail(fmt::format("output.fields names '{}' twice", name_of(fields[k])));
+        }
+    }
+    if (o.snapshot_format.precision != SnapshotPrecision::Float64 && o.snapshot_format.precision != SnapshotPrecision::Float32) {
+        fail(fmt::format("output.precision = {} is neither Float64 nor Float32", static_cast<int>(o.snapshot_format.precision)));
+    }
 }
 
 std::string region_label(const PrescribedVelocitySpec& r, std::size_t i) {

@@ -50,7 +50,7 @@ enum class GaugeField {
     Temperature,       // K
     Density,           // mass / volume (kg/m^3)
     InternalEnergy,    // specific internal energy (J/kg)
-    Damage,            // Johnson-Cook damage D
+    Damage,            // Johnson-Cook damage D, each node's at most 1
     VolumetricStrain,  // V / V0 - 1
 };
 

@@ -18,6 +18,7 @@
 #include "gpa/engine/errors.hpp"
 #include "gpa/engine/gauges.hpp"
 #include "gpa/engine/geometry.hpp"
+#include "gpa/engine/snapshot_fields.hpp"
 #include "gpa/engine/weights.hpp"
 #include "gpa/materials/material.hpp"
 
@@ -265,6 +266,8 @@ struct OutputOptions {
     // (measure.hpp), m; 0 = twice the first body's spacing. The scene reader fixes it from the scene
     // as written, so that a study's refined runs keep one radius.
     double peak_radius = 0.0;
+    // The arrays of every snapshot and the width of their floats (snapshot_fields.hpp).
+    SnapshotFormat snapshot_format{default_snapshot_fields(), SnapshotPrecision::Float64};
 };
 
 struct Scene {

@@ -164,7 +164,9 @@ Snapshot take_snapshot(const Simulation& sim);
 // always lists the snapshots on disk.
 class SnapshotSeries {
 public:
-    explicit SnapshotSeries(std::filesystem::path folder, std::string stem = "particles");
+    // `format`: the arrays and float width of every file (the scene's [output] fields and precision).
+    explicit SnapshotSeries(std::filesystem::path folder, std::string stem = "particles",
+                            SnapshotFormat format = {default_snapshot_fields(), SnapshotPrecision::Float64});
     // Writes the snapshot's particles (if any) and element bodies (if any) as the parts of the next
     // scheduled time step (particles_NNNNN.vtp, elements_NNNNN.vtu); returns the file names.
     std::vector<std::string> write(const Snapshot& snapshot);
@@ -184,6 +186,7 @@ private:
     std::vector<std::string> write_parts(const Snapshot& snapshot, const std::string& suffix, const std::string& mark);
     std::filesystem::path folder_;
     std::string stem_;
+    SnapshotFormat format_;
     std::vector<PvdEntry> entries_;
     std::size_t scheduled_ = 0;
 };

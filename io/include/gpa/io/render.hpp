@@ -65,10 +65,12 @@ struct ViewPoint {
 ViewPoint project(const std::array<double, 3>& p, ViewDirection view);
 
 // What to colour by: "pressure", "velocity" (a vector: its magnitude), "velocity:z" (a
-// component: x, z in 2D, x, y, z in 3D, or "magnitude").
+// component: x, z in 2D, x, y, z in 3D, or "magnitude"), "stress:xz" (a component of a symmetric
+// tensor: xx, yy, zz, xy, yz, xz in 3D; xx, zz, xz and hoop (axisymmetric) or yy (plane strain) in 2D).
 struct FieldChoice {
     std::string name;
     std::optional<int> component;  // index into the stored components; nullopt: magnitude or scalar
+    bool tensor = false;           // the component is a tensor's (xx, ...), not a vector's (x, ...)
     std::string label;             // "velocity:z", "|velocity|", "pressure"
 };
 // Throws InputError for an empty name or a component that is not one of the geometry's axes.
@@ -107,7 +109,7 @@ LoadedSnapshot load_snapshot(const SnapshotIndex& series, std::size_t index);
 std::size_t snapshot_nearest(const SnapshotIndex& series, double t);
 
 // The fields a snapshot holds (point data of every part, cell data of element parts): name,
-// components and which parts have it, with the range of each (magnitude of vectors) over finite
+// components and which parts have it, with the range of each (magnitude of vectors, every component of tensors) over finite
 // values.
 struct FieldSummary {
     std::string name;
