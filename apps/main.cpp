@@ -4,8 +4,9 @@
 //   gpa study SCENE [-o DIR] [--refine 1,1.5,2] [--variant NAME:key=value,...]... [--threads 1,2] [--overwrite] [-q]
 //             [--reference FILE]
 //   gpa check SCENE [--max-memory SIZE]
-//   gpa render RUN_DIR [--field NAME[:x|y|z]] [-o PNG] [--snapshot N|last | --time T] [--size WxH | --width W]
-//              [--range MIN:MAX] [--mirror | --no-mirror] [--view +y] [--geometry G] [--list] [-q]
+//   gpa render RUN_DIR [--field NAME[:x|y|z|xx|...]] [-o PNG] [--snapshot N|last | --time T] [--size WxH | --width W]
+//              [--range MIN:MAX] [--mirror | --no-mirror] [--view +y] [--region R | --frame run] [--no-failed-marks]
+//              [--geometry G] [--list] [-q]
 //   gpa materials
 //   gpa demo [--threads N] [-o DIR]
 //   gpa --version
@@ -171,9 +172,14 @@ int main(int argc, char** argv) {
     render->add_flag("--no-mirror", render_options.no_mirror, "2D: do not mirror an axisymmetric run")->excludes(render_mirror);
     render->add_option("--view", render_options.view,
                        "3D: the direction the picture looks along, +x, -x, +y, -y, +z or -z (default +y: x right, z up)");
-    render->add_option("--region", render_options.region,
+    auto* render_region = render->add_option("--region", render_options.region,
                        "draw only this window, LEFT:RIGHT,BOTTOM:TOP in the picture's axes (2D: x and z), e.g. -30mm:30mm,-10mm:20mm "
                        "(plain numbers in m)");
+    render->add_option("--frame", render_options.frame,
+                       "snapshot (default: the drawing fits the snapshot) or run (one frame that holds every snapshot of the run, "
+                       "so that motion shows)")
+        ->excludes(render_region);
+    render->add_flag("--no-failed-marks", render_options.no_failed_marks, "no black dot on failed nodes and cells");
     render->add_option("--geometry", render_options.geometry,
                        "axisymmetric, plane-strain or 3d (default: the run's scene.toml or summary.json)");
     render->add_flag("--list", render_options.list, "list the snapshots and the fields of the chosen one, and draw nothing");

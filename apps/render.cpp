@@ -12,6 +12,7 @@
 #include "gpa/engine/errors.hpp"
 #include "gpa/io/atomic_file.hpp"
 #include "gpa/io/render.hpp"
+#include "gpa/io/scene_file.hpp"
 #include "gpa/io/snapshot_reader.hpp"
 #include "gpa/io/units.hpp"
 
@@ -185,6 +186,11 @@ int render_run(const RenderCommandOptions& o) {
         if (!options.view) throw InputError(fmt::format("--view '{}': expected +x, -x, +y, -y, +z or -z", o.view));
     }
     if (!o.region.empty()) options.region = region_named(o.region);
+    if (o.frame != "snapshot" && o.frame != "run") {
+        throw InputError(fmt::format("--frame '{}': expected snapshot (fitted to the snapshot) or run (one frame for every snapshot)",
+                                     o.frame));
+    }
+    options.mark_failed = !o.no_failed_marks;
     if (o.mirror) options.mirror = true;
     if (o.no_mirror) options.mirror = false;
 
@@ -228,7 +234,24 @@ int render_run(const RenderCommandOptions& o) {
         if (!high.empty()) options.range_max = range_end(high, field_name, o.range);
         if (low.empty() && high.empty()) throw InputError(fmt::format("--range '{}': give MIN, MAX or both", o.range));
     }
-    options.title = fmt::format("{}  snapshot {} of 0-{}", folder.filename().string(), snapshot.index, series.snapshots.size() - 1);
+    // The run's scene, for the title, the names of bodies and materials and the planes drawn. A
+    // scene.toml that does not read (another version's) costs only these: the picture is drawn.
+    std::optional<Scene> scene;
+    std::string scene_note;
+    std::error_code scene_ec;  // a scene.toml that cannot be examined is taken as absent
+    if (const fs::path file = folder / "scene.toml"; fs::is_regular_file(file, scene_ec)) {
+        try {
+            scene = io::parse_scene(io::read_scene_text(file), file.string());
+            options.scene = &*scene;
+        } catch (const InputError& e) {
+            scene_note = fmt::format("note: drawn without the scene's names and planes: {}", e.what());
+        }
+    }
+    const std::string run_name = folder.filename().string() == "." ? fs::absolute(folder).filename().string() : folder.filename().string();
+    options.title = scene && !scene->name.empty()
+                        ? fmt::format("{} ({})  snapshot {} of 0-{}", scene->name, run_name, snapshot.index, series.snapshots.size() - 1)
+                        : fmt::format("{}  snapshot {} of 0-{}", run_name, snapshot.index, series.snapshots.size() - 1);
+    if (o.frame == "run") options.region = io::series_extent(series, geometry, options);
     const io::Picture picture = io::render_snapshot(snapshot, geometry, options);
 
     fs::path output;
@@ -256,6 +279,8 @@ int render_run(const RenderCommandOptions& o) {
         if (picture.not_finite_values) fmt::print("note: {} values not finite (drawn magenta)\n", picture.not_finite_values);
         if (picture.not_finite_positions) fmt::print("note: {} nodes or cells with positions not finite left out\n", picture.not_finite_positions);
         if (picture.without_field) fmt::print("note: {} nodes or cells of parts without the field (drawn grey)\n", picture.without_field);
+        if (picture.failed) fmt::print("note: {} failed nodes or cells (marked with a black dot)\n", picture.failed);
+        if (!scene_note.empty()) fmt::print("{}\n", scene_note);
         if (picture.below_range + picture.above_range) {
             fmt::print("note: {} below and {} above the colour range (drawn in its end colours)\n", picture.below_range,
                        picture.above_range);

@@ -20,6 +20,8 @@ struct RenderCommandOptions {
     bool mirror = false, no_mirror = false;
     std::string view;              // 3D: "+y", "-z", ...
     std::string region;            // "LEFT:RIGHT,BOTTOM:TOP", lengths with units or plain metres
+    std::string frame = "snapshot";  // "snapshot": fitted to the snapshot; "run": one frame for every snapshot
+    bool no_failed_marks = false;  // no black dot on failed nodes
     std::string geometry;          // override: axisymmetric, plane-strain, 3d
     bool list = false;
     bool quiet = false;

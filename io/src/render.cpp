@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <cstring>
 #include <limits>
 
@@ -348,6 +349,7 @@ struct Disc {
     double u, v, radius, depth;
     double value;
     bool has_value;
+    bool failed = false;
 };
 
 struct Triangle {
@@ -355,6 +357,7 @@ struct Triangle {
     std::array<double, 3> value;  // the same three times for a cell field
     bool has_value;
     double depth;
+    bool failed = false;  // its cell has failed
 };
 
 // The field on one part: its values per point or per cell, or nullopt when the part lacks it.
@@ -479,7 +482,8 @@ void draw_disc(Image& img, const Area& plot, const PictureFrame& frame, const Di
     if (!any && cx >= plot.x0 && cx < plot.x1 && cy >= plot.y0 && cy < plot.y1) img.set(cx, cy, colour);
 }
 
-void draw_triangle(Image& img, const Area& plot, const PictureFrame& frame, const Triangle& t, double lo, double hi) {
+void draw_triangle(Image& img, const Area& plot, const PictureFrame& frame, const Triangle& t,
+                   const std::function<Rgb(double, bool)>& paint) {
     std::array<std::array<double, 2>, 3> p;
     for (int k = 0; k < 3; ++k) p[k] = frame.pixel(t.corner[k].u, t.corner[k].v);
     const auto edge = [](const std::array<double, 2>& a, const std::array<double, 2>& b, double x, double y) {
@@ -502,18 +506,9 @@ void draw_triangle(Image& img, const Area& plot, const PictureFrame& frame, cons
             const double w2 = edge(p[0], p[1], cx, cy) / area;
             if (w0 < 0.0 || w1 < 0.0 || w2 < 0.0) continue;
             const double v = w0 * t.value[0] + w1 * t.value[1] + w2 * t.value[2];
-            img.set(x, y, colour_of(v, t.has_value, lo, hi));
+            img.set(x, y, paint(v, t.has_value));
         }
     }
-}
-
-// A round length for the scale bar: 1, 2 or 5 times a power of ten, at most `longest`.
-double round_length(double longest) {
-    const double decade = std::pow(10.0, std::floor(std::log10(longest)));
-    for (double f : {5.0, 2.0, 1.0}) {
-        if (f * decade <= longest) return f * decade;
-    }
-    return decade;
 }
 
 }  // namespace
@@ -554,6 +549,12 @@ Picture render_snapshot(const LoadedSnapshot& snapshot, GeometryKind geometry, c
         const std::vector<double> raw = part.points();
         std::vector<ViewPoint> points(part.point_count());
         for (std::size_t i = 0; i < points.size(); ++i) points[i] = to_view(raw.data() + 3 * i);
+        // The part's failure flags (point data of particles, cell data of element bodies).
+        std::vector<double> failed;
+        if (options.mark_failed && choice.name != "failed") {
+            const DataLocation at = part.type() == "PolyData" ? DataLocation::Point : DataLocation::Cell;
+            if (const VtkArrayInfo* f = part.find("failed", at); f && f->components == 1) failed = part.values("failed", at);
+        }
         if (part.type() == "PolyData") {
             std::vector<double> diameter;
             if (const VtkArrayInfo* d = part.find("diameter", DataLocation::Point); d && d->components == 1) {
@@ -567,7 +568,8 @@ Picture render_snapshot(const LoadedSnapshot& snapshot, GeometryKind geometry, c
                 }
                 const double d = diameter.empty() || !(diameter[i] > 0.0) || !std::isfinite(diameter[i]) ? spacing : diameter[i];
                 const double value = field ? field->values[i] : 0.0;
-                discs.push_back({points[i].u, points[i].v, 0.5 * (d > 0.0 ? d : spacing), points[i].depth, value, field.has_value()});
+                discs.push_back({points[i].u, points[i].v, 0.5 * (d > 0.0 ? d : spacing), points[i].depth, value, field.has_value(),
+                                 !failed.empty() && failed[i] != 0.0});
                 if (!field) ++picture.without_field;
             }
         } else {
@@ -595,6 +597,7 @@ Picture render_snapshot(const LoadedSnapshot& snapshot, GeometryKind geometry, c
                         continue;
                     }
                     t.has_value = field.has_value();
+                    t.failed = !failed.empty() && failed[c] != 0.0;
                     t.depth = (t.corner[0].depth + t.corner[1].depth + t.corner[2].depth) / 3.0;
                     triangles.push_back(t);
                 }
@@ -720,13 +723,46 @@ Picture render_snapshot(const LoadedSnapshot& snapshot, GeometryKind geometry, c
     picture.range_min = lo;
     picture.range_max = hi;
 
-    // Layout: text at the top, the colour bar on the right, the length scale at the bottom.
+    // Body and material indices are categories: a colour and a name each (the scene's names when
+    // the run's scene is known), unless a colour range was asked for.
+    picture.categorical = (choice.name == "body" || choice.name == "material") && !choice.component && !options.range_min &&
+                          !options.range_max;
+    std::vector<long long> categories;
+    if (picture.categorical) {
+        const auto add = [&](double v, bool has) {
+            if (has && std::isfinite(v)) categories.push_back(std::llround(v));
+        };
+        for (std::size_t i = 0; i < own_discs; ++i) add(discs[i].value, discs[i].has_value);
+        for (std::size_t i = 0; i < own_triangles; ++i) add(triangles[i].value[0], triangles[i].has_value);
+        std::sort(categories.begin(), categories.end());
+        categories.erase(std::unique(categories.begin(), categories.end()), categories.end());
+    }
+    const auto category_name = [&](long long k) {
+        const Scene* scene = options.scene;
+        if (scene && k >= 0) {
+            const auto i = static_cast<std::size_t>(k);
+            if (choice.name == "body" && i < scene->bodies.size()) return fmt::format("{} {}", k, scene->bodies[i].name);
+            if (choice.name == "material" && i < scene->materials.size()) return fmt::format("{} {}", k, scene->materials[i].name);
+        }
+        return fmt::format("{} {}", choice.name, k);
+    };
+    const std::function<Rgb(double, bool)> paint = [&](double v, bool has) {
+        if (picture.categorical && has && std::isfinite(v)) return category_colour(std::llround(v));
+        return colour_of(v, has, lo, hi);
+    };
+    for (std::size_t i = 0; i < own_discs; ++i) picture.failed += discs[i].failed;
+    for (std::size_t i = 0; i < own_triangles; ++i) picture.failed += triangles[i].failed;
+
+    // Layout: text at the top, the colour bar (or legend) on the right, coordinates along the left
+    // and bottom edges of the drawing, notes at the bottom.
     const DisplayUnit shown = display_unit(std::max(std::abs(lo), std::abs(hi)), picture.unit);
     const double divisor = std::pow(10.0, shown.exponent);
     const bool uniform = !(hi > lo);
     const std::array<double, 5> tick_fractions{1.0, 0.75, 0.5, 0.25, 0.0};
     std::vector<std::string> tick_labels;
-    if (uniform) {
+    if (picture.categorical) {
+        for (const long long k : categories) tick_labels.push_back(category_name(k));
+    } else if (uniform) {
         tick_labels.push_back(number_text(lo / divisor) + " (uniform)");
     } else {
         for (double f : tick_fractions) tick_labels.push_back(number_text((lo + f * (hi - lo)) / divisor));
@@ -738,10 +774,37 @@ Picture render_snapshot(const LoadedSnapshot& snapshot, GeometryKind geometry, c
     const int margin = 8 * s, text_h = detail::text_height(s), line = detail::line_height * s;
     int label_w = 0;
     for (const auto& l : tick_labels) label_w = std::max(label_w, detail::text_width(l, s));
+    label_w = std::min(label_w, width / 3);  // long names are shortened to fit
     const int bar_w = 16 * s, tick_len = 4 * s;
     const int right = margin + bar_w + tick_len + 2 * s + label_w + margin;
-    const int top = margin + 2 * line + margin / 2;
-    const int bottom = margin + 2 * s + 4 * s + line + line + margin / 2;
+    const int top = margin + 2 * line + margin / 2 + line;  // title, field and time; the vertical axis' name
+    const int bottom = margin / 2 + tick_len + 2 * s + line + line + margin / 2;  // ticks, their labels, notes
+
+    // The scene's rigid and symmetry planes the view sees edge-on, as lines of the picture plane:
+    // u = c (vertical) or v = c (horizontal). 2D scenes store (x, z) as the first two coordinates,
+    // as the snapshots do; a 2D plane normal to x is mirrored with the run.
+    struct PlaneLine {
+        const PlaneSpec* plane;
+        bool vertical;
+        double at;             // u or v
+        double toward_bodies;  // +1: the bodies lie towards +u (+v)
+    };
+    std::vector<PlaneLine> plane_lines;
+    if (options.scene) {
+        for (const PlaneSpec& plane : options.scene->planes) {
+            if (plane.axis < 0 || plane.axis > (three_d ? 2 : 1)) continue;
+            std::array<double, 3> normal{}, point{};
+            normal[static_cast<std::size_t>(plane.axis)] = 1.0;
+            point[static_cast<std::size_t>(plane.axis)] = plane.position;
+            const ViewPoint n = three_d ? project(normal, view) : ViewPoint{normal[0], normal[1], 0.0};
+            const ViewPoint at = three_d ? project(point, view) : ViewPoint{point[0], point[1], 0.0};
+            if (n.u == 0.0 && n.v == 0.0) continue;  // faces the viewer
+            const bool vertical_line = n.u != 0.0;
+            const double side = plane.side * (vertical_line ? n.u : n.v);
+            plane_lines.push_back({&plane, vertical_line, vertical_line ? at.u : at.v, side});
+            if (mirror && vertical_line && at.u != 0.0) plane_lines.push_back({&plane, true, -at.u, -side});
+        }
+    }
 
     double umin = std::numeric_limits<double>::infinity(), umax = -umin, vmin = umin, vmax = -umin;
     const auto extend = [&](double u, double v, double r) {
@@ -758,18 +821,74 @@ Picture render_snapshot(const LoadedSnapshot& snapshot, GeometryKind geometry, c
         for (const auto& t : triangles) {
             for (const auto& c : t.corner) extend(c.u, c.v, 0.0);
         }
+        // The drawing reaches to the planes, so that a gap between a body and its wall shows.
+        for (const PlaneLine& l : plane_lines) {
+            if (l.vertical) {
+                umin = std::min(umin, l.at);
+                umax = std::max(umax, l.at);
+            } else {
+                vmin = std::min(vmin, l.at);
+                vmax = std::max(vmax, l.at);
+            }
+        }
     }
     double world_w = umax - umin, world_h = vmax - vmin;
     const double world_size = std::max(world_w, world_h) > 0.0 ? std::max(world_w, world_h) : 1e-3;
     world_w = std::max(world_w, 1e-3 * world_size);
     world_h = std::max(world_h, 1e-3 * world_size);
-    const int plot_w = width - margin - right;
+
+    // The coordinates shown along the axes: each picture axis is a world axis, perhaps reversed
+    // (3D views such as -y have x growing to the left), in one length unit for both.
+    struct Axis {
+        char name;
+        double sign;
+    };
+    const auto axis_of = [&](int picture_axis) -> Axis {
+        if (!three_d) return picture_axis == 0 ? Axis{'x', 1.0} : Axis{'z', 1.0};
+        for (int a = 0; a < 3; ++a) {
+            std::array<double, 3> e{};
+            e[a] = 1.0;
+            const ViewPoint p = project(e, view);
+            const double along = picture_axis == 0 ? p.u : p.v;
+            if (along != 0.0) return Axis{static_cast<char>('x' + a), along};
+        }
+        return Axis{'?', 1.0};
+    };
+    const Axis horizontal = axis_of(0), vertical = axis_of(1);
+    const DisplayUnit length_unit = display_unit(std::max({std::abs(umin), std::abs(umax), std::abs(vmin), std::abs(vmax)}), "m");
+    const double length_divisor = std::pow(10.0, length_unit.exponent);
+    // Round tick steps (1, 2 or 5 times a power of ten) giving at most `most` ticks over [a, b].
+    const auto ticks_over = [](double a, double b, int most) {
+        std::vector<double> out;
+        const double span = b - a;
+        if (!(span > 0.0) || most < 2) return out;
+        const double raw = span / most;
+        const double decade = std::pow(10.0, std::floor(std::log10(raw)));
+        double step = 10.0 * decade;
+        for (double f : {1.0, 2.0, 5.0}) {
+            if (f * decade >= raw) {
+                step = f * decade;
+                break;
+            }
+        }
+        for (double t = std::ceil(a / step) * step; t <= b + 1e-9 * span; t += step) out.push_back(std::abs(t) < 1e-9 * span ? 0.0 : t);
+        return out;
+    };
+    const auto coordinate_text = [&](double picture_coordinate, const Axis& axis) {
+        return number_text(axis.sign * picture_coordinate / length_divisor);
+    };
+    // The left margin holds the vertical axis' labels, six characters wide whatever the values
+    // (round ticks of three digits: "-12.5", "0.25"), so that the drawing's width, and with it a
+    // free height's proportions, do not depend on the coordinates.
+    const int left = margin + detail::text_width("-000.0", s) + tick_len + 2 * s;
+
+    const int plot_w = width - left - right;
     int height = options.height;
     if (height == 0) {
         const double wanted = top + bottom + plot_w * world_h / world_w;
         height = static_cast<int>(std::clamp(std::ceil(wanted), double(min_height), double(std::min(max_side, 2 * width))));
     }
-    const Area plot{margin, top, width - right, height - bottom};
+    const Area plot{left, top, width - right, height - bottom};
     if (plot.x1 - plot.x0 < 16 || plot.y1 - plot.y0 < 16) {
         throw InputError(fmt::format("picture {}x{} px leaves no room for the drawing beside the colour bar and text; make it larger",
                                      width, height));
@@ -784,52 +903,136 @@ Picture render_snapshot(const LoadedSnapshot& snapshot, GeometryKind geometry, c
     picture.frame = frame;
 
     Image img(width, height, background_colour);
-    for (const auto& t : triangles) draw_triangle(img, plot, frame, t, lo, hi);
-    for (const auto& d : discs) draw_disc(img, plot, frame, d, colour_of(d.value, d.has_value, lo, hi));
+    for (const auto& t : triangles) draw_triangle(img, plot, frame, t, paint);
+    for (const auto& d : discs) draw_disc(img, plot, frame, d, paint(d.value, d.has_value));
+    // Failure: a black dot at the centre of each failed node (a third of its radius, at least a
+    // pixel across) and of each failed triangle.
+    if (picture.failed > 0) {
+        for (const auto& d : discs) {
+            if (d.failed) draw_disc(img, plot, frame, {d.u, d.v, std::max(0.35 * d.radius, 0.75 / frame.scale), d.depth, 0.0, true}, text_colour);
+        }
+        for (const auto& t : triangles) {
+            if (!t.failed) continue;
+            const double u = (t.corner[0].u + t.corner[1].u + t.corner[2].u) / 3.0, v = (t.corner[0].v + t.corner[1].v + t.corner[2].v) / 3.0;
+            draw_disc(img, plot, frame, {u, v, 1.0 / frame.scale, t.depth, 0.0, true}, text_colour);
+        }
+    }
+
+    // The planes: a line across the drawing (rigid: solid, with short strokes on the side away
+    // from the bodies; symmetry: dashed) and the plane's name beside it on the wall's side.
+    for (const PlaneLine& l : plane_lines) {
+        const auto [px, py] = frame.pixel(l.vertical ? l.at : 0.0, l.vertical ? 0.0 : l.at);
+        const int p = static_cast<int>(std::lround(l.vertical ? px : py));
+        if (l.vertical ? (p < plot.x0 || p >= plot.x1) : (p < plot.y0 || p >= plot.y1)) continue;
+        const int from = l.vertical ? plot.y0 : plot.x0, to = l.vertical ? plot.y1 : plot.x1;
+        const bool dashed = l.plane->kind == PlaneKind::Symmetry;
+        const int thick = std::max(s, 1);
+        for (int q = from; q < to; ++q) {
+            if (dashed && ((q - from) / (6 * s)) % 2 == 1) continue;
+            if (l.vertical) {
+                fill_rect(img, p - s / 2, q, p - s / 2 + thick, q + 1, text_colour);
+            } else {
+                fill_rect(img, q, p - s / 2, q + 1, p - s / 2 + thick, text_colour);
+            }
+        }
+        // The wall's side in pixels: -x on screen for bodies towards +u; +y (down) for bodies towards +v.
+        const int away = l.vertical ? (l.toward_bodies > 0 ? -1 : 1) : (l.toward_bodies > 0 ? 1 : -1);
+        if (!dashed) {
+            for (int q = from + 3 * s; q < to; q += 8 * s) {
+                for (int k = 0; k < 5 * s; ++k) {
+                    if (l.vertical) {
+                        img.set(p + away * k, q + k, text_colour);
+                    } else {
+                        img.set(q + k, p + away * k, text_colour);
+                    }
+                }
+            }
+        }
+        // Its name on the wall's side past the strokes, or on the other side where the drawing ends.
+        const std::string label = fitted(l.plane->name, (plot.x1 - plot.x0) / 2, s);
+        const int name_w = detail::text_width(label, s);
+        if (l.vertical) {
+            int x = away < 0 ? p - 6 * s - name_w : p + 6 * s;
+            if (x < plot.x0 || x + name_w > plot.x1) x = away < 0 ? p + 3 * s : p - 3 * s - name_w;
+            draw_text(img, x, plot.y0 + s, label, s, text_colour);
+        } else {
+            int y = away > 0 ? p + 6 * s : p - text_h - 6 * s;
+            if (y < plot.y0 || y + text_h > plot.y1) y = away > 0 ? p - text_h - 3 * s : p + 3 * s;
+            draw_text(img, plot.x1 - name_w - s, y, label, s, text_colour);
+        }
+        ++picture.planes_drawn;
+    }
 
     // Text at the top: the title and mark, then the field, its unit and the time.
     std::string first = options.title;
     if (!snapshot.entry.mark.empty()) first += (first.empty() ? "" : "  ") + std::string("[") + snapshot.entry.mark + "]";
     if (first.empty()) first = snapshot.entry.files.front().filename().string();
     std::string second = choice.label;
-    if (!shown.unit.empty()) second += " (" + shown.unit + ")";
+    if (!shown.unit.empty() && !picture.categorical) second += " (" + shown.unit + ")";
     second += "   t = " + format_quantity(snapshot.entry.time, "s");
     if (three_d) second += "   view " + std::string(name_of(view));
     const int text_room = width - 2 * margin;
     draw_text(img, margin, margin, fitted(first, text_room, s), s, text_colour);
     draw_text(img, margin, margin + line, fitted(second, text_room, s), s, text_colour);
 
-    // The colour bar, its frame, ticks and labels.
+    // Coordinates: ticks and labels along the bottom (horizontal axis) and left (vertical axis)
+    // edges, and each axis' name with the unit.
+    fill_rect(img, plot.x0, plot.y1, plot.x1, plot.y1 + std::max(s / 2, 1), text_colour);
+    fill_rect(img, plot.x0 - std::max(s / 2, 1), plot.y0, plot.x0, plot.y1, text_colour);
+    const double visible_w = plot_wd / frame.scale, visible_h = plot_hd / frame.scale;
+    const int most_u = std::max(2, static_cast<int>(plot_wd / std::max(1, detail::text_width("-00.00", s) + 6 * s)));
+    const int most_v = std::max(2, static_cast<int>(plot_hd / (3 * line)));
+    for (const double u : ticks_over(frame.u_left, frame.u_left + visible_w, std::min(most_u, 10))) {
+        const int x = static_cast<int>(std::lround(frame.pixel(u, 0.0)[0]));
+        fill_rect(img, x - s / 2, plot.y1, x - s / 2 + std::max(s, 1), plot.y1 + tick_len, text_colour);
+        const std::string label = coordinate_text(u, horizontal);
+        const int w = detail::text_width(label, s);
+        draw_text(img, std::clamp(x - w / 2, 0, width - w), plot.y1 + tick_len + 2 * s, label, s, text_colour);
+    }
+    for (const double v : ticks_over(frame.v_top - visible_h, frame.v_top, std::min(most_v, 10))) {
+        const int y = static_cast<int>(std::lround(frame.pixel(0.0, v)[1]));
+        fill_rect(img, plot.x0 - tick_len, y - s / 2, plot.x0, y - s / 2 + std::max(s, 1), text_colour);
+        const std::string label = coordinate_text(v, vertical);
+        draw_text(img, plot.x0 - tick_len - 2 * s - detail::text_width(label, s), y - text_h / 2 + s, label, s, text_colour);
+    }
+    const std::string u_name = fmt::format("{} ({})", horizontal.name, length_unit.unit);
+    const std::string v_name = fmt::format("{} ({})", vertical.name, length_unit.unit);
+    draw_text(img, plot.x1 - detail::text_width(u_name, s), plot.y1 + tick_len + 2 * s + line, u_name, s, text_colour);
+    draw_text(img, margin, plot.y0 - line, v_name, s, text_colour);
+
+    // The colour bar, its frame, ticks and labels; or, for categories, a swatch and name each.
     const int bar_x = width - right + margin;
     const int bar_top = plot.y0 + text_h / 2;
-    const int bar_h = std::max(40 * s, static_cast<int>(0.6 * (plot.y1 - plot.y0)));
-    const int bar_bottom = std::min(plot.y1 - text_h / 2, bar_top + bar_h);
-    const int rows = bar_bottom - bar_top;
-    for (int y = bar_top; y < bar_bottom; ++y) {
-        const double f = uniform ? 0.5 : 1.0 - (y - bar_top + 0.5) / rows;
-        fill_rect(img, bar_x, y, bar_x + bar_w, y + 1, colour_map(f));
-    }
-    fill_rect(img, bar_x - 1, bar_top - 1, bar_x + bar_w + 1, bar_top, text_colour);
-    fill_rect(img, bar_x - 1, bar_bottom, bar_x + bar_w + 1, bar_bottom + 1, text_colour);
-    fill_rect(img, bar_x - 1, bar_top - 1, bar_x, bar_bottom + 1, text_colour);
-    fill_rect(img, bar_x + bar_w, bar_top - 1, bar_x + bar_w + 1, bar_bottom + 1, text_colour);
-    for (std::size_t k = 0; k < tick_labels.size(); ++k) {
-        const double f = uniform ? 0.5 : tick_fractions[k];
-        const int y = bar_top + static_cast<int>(std::lround((1.0 - f) * rows));
-        fill_rect(img, bar_x + bar_w, y - s / 2, bar_x + bar_w + tick_len, y - s / 2 + s, text_colour);
-        draw_text(img, bar_x + bar_w + tick_len + 2 * s, y - text_h / 2 + s, tick_labels[k], s, text_colour);
+    if (picture.categorical) {
+        for (std::size_t k = 0; k < categories.size(); ++k) {
+            const int y = bar_top + static_cast<int>(k) * (line + s);
+            if (y + line > height) break;
+            fill_rect(img, bar_x, y, bar_x + bar_w, y + text_h, category_colour(categories[k]));
+            draw_text(img, bar_x + bar_w + tick_len + 2 * s, y, fitted(tick_labels[k], label_w, s), s, text_colour);
+        }
+    } else {
+        const int bar_h = std::max(40 * s, static_cast<int>(0.6 * (plot.y1 - plot.y0)));
+        const int bar_bottom = std::min(plot.y1 - text_h / 2, bar_top + bar_h);
+        const int rows = bar_bottom - bar_top;
+        for (int y = bar_top; y < bar_bottom; ++y) {
+            const double f = uniform ? 0.5 : 1.0 - (y - bar_top + 0.5) / rows;
+            fill_rect(img, bar_x, y, bar_x + bar_w, y + 1, colour_map(f));
+        }
+        fill_rect(img, bar_x - 1, bar_top - 1, bar_x + bar_w + 1, bar_top, text_colour);
+        fill_rect(img, bar_x - 1, bar_bottom, bar_x + bar_w + 1, bar_bottom + 1, text_colour);
+        fill_rect(img, bar_x - 1, bar_top - 1, bar_x, bar_bottom + 1, text_colour);
+        fill_rect(img, bar_x + bar_w, bar_top - 1, bar_x + bar_w + 1, bar_bottom + 1, text_colour);
+        for (std::size_t k = 0; k < tick_labels.size(); ++k) {
+            const double f = uniform ? 0.5 : tick_fractions[k];
+            const int y = bar_top + static_cast<int>(std::lround((1.0 - f) * rows));
+            fill_rect(img, bar_x + bar_w, y - s / 2, bar_x + bar_w + tick_len, y - s / 2 + s, text_colour);
+            draw_text(img, bar_x + bar_w + tick_len + 2 * s, y - text_h / 2 + s, tick_labels[k], s, text_colour);
+        }
     }
 
-    // The length scale under the drawing, and a note on what is not coloured by the field.
-    const double visible = plot_wd / frame.scale;
-    const double length = round_length(0.25 * visible);
-    const int length_px = static_cast<int>(std::lround(length * frame.scale));
-    const int scale_y = plot.y1 + margin / 2 + 4 * s;
-    fill_rect(img, plot.x0, scale_y, plot.x0 + length_px, scale_y + 2 * s, text_colour);
-    fill_rect(img, plot.x0, scale_y - 2 * s, plot.x0 + s, scale_y + 4 * s, text_colour);
-    fill_rect(img, plot.x0 + length_px - s, scale_y - 2 * s, plot.x0 + length_px, scale_y + 4 * s, text_colour);
-    draw_text(img, plot.x0, scale_y + 6 * s, format_quantity(length, "m"), s, text_colour);
+    // A note under the coordinates on what is not coloured by the field.
     std::vector<std::string> notes;
+    if (picture.failed > 0) notes.push_back(fmt::format("black dot: {} failed", picture.failed));
     if (picture.not_finite_values > 0) notes.push_back(fmt::format("magenta: {} not finite", picture.not_finite_values));
     if (picture.without_field > 0) notes.push_back(fmt::format("grey: {} without {}", picture.without_field, choice.name));
     if (picture.not_finite_positions > 0) notes.push_back(fmt::format("{} left out (position not finite)", picture.not_finite_positions));
@@ -839,11 +1042,64 @@ Picture render_snapshot(const LoadedSnapshot& snapshot, GeometryKind geometry, c
     if (!notes.empty()) {
         std::string text;
         for (const auto& n : notes) text += (text.empty() ? "" : "; ") + n;
-        const int x = plot.x0 + std::max(length_px, detail::text_width(format_quantity(length, "m"), s)) + 3 * margin;
-        draw_text(img, x, scale_y + 6 * s, fitted(text, width - x - margin, s), s, text_colour);
+        const int room = plot.x1 - detail::text_width(u_name, s) - 3 * margin - plot.x0;
+        draw_text(img, plot.x0, plot.y1 + tick_len + 2 * s + line, fitted(text, std::max(room, 0), s), s, text_colour);
     }
     picture.image = std::move(img);
     return picture;
+}
+
+Rgb category_colour(long long k) {
+    // Okabe and Ito's colours for readers with colour-blindness, less their black (the text's and
+    // the failure marks' colour): orange, sky blue, bluish green, yellow, blue, vermilion, purple.
+    static constexpr std::array<Rgb, 7> colours{{{230, 159, 0}, {86, 180, 233}, {0, 158, 115}, {240, 228, 66}, {0, 114, 178},
+                                                 {213, 94, 0}, {204, 121, 167}}};
+    const long long n = static_cast<long long>(colours.size());
+    return colours[static_cast<std::size_t>(((k % n) + n) % n)];
+}
+
+std::array<double, 4> series_extent(const SnapshotIndex& series, GeometryKind geometry, const RenderOptions& options) {
+    const bool three_d = geometry == GeometryKind::ThreeD;
+    const ViewDirection view = options.view.value_or(ViewDirection::PlusY);
+    const bool mirror = !three_d && options.mirror.value_or(geometry == GeometryKind::Axisymmetric);
+    double umin = std::numeric_limits<double>::infinity(), umax = -umin, vmin = umin, vmax = -umin;
+    const auto extend = [&](const ViewPoint& p, double r) {
+        if (!finite(p) || !std::isfinite(r)) return;
+        for (const double u : {p.u, mirror ? -p.u : p.u}) {
+            umin = std::min(umin, u - r);
+            umax = std::max(umax, u + r);
+        }
+        vmin = std::min(vmin, p.v - r);
+        vmax = std::max(vmax, p.v + r);
+    };
+    for (std::size_t k = 0; k < series.snapshots.size(); ++k) {
+        const LoadedSnapshot snapshot = load_snapshot(series, k);
+        for (const auto& part : snapshot.parts) {
+            const std::vector<double> raw = part.points();
+            std::vector<ViewPoint> points(part.point_count());
+            for (std::size_t i = 0; i < points.size(); ++i) {
+                const double* p = raw.data() + 3 * i;
+                points[i] = three_d ? project({p[0], p[1], p[2]}, view) : ViewPoint{p[0], p[1], 0.0};
+            }
+            std::vector<double> diameter;
+            if (part.type() == "PolyData") {
+                if (const VtkArrayInfo* d = part.find("diameter", DataLocation::Point); d && d->components == 1) {
+                    diameter = part.values("diameter", DataLocation::Point);
+                }
+            }
+            // As render_snapshot draws them: a disc of the node's diameter (or of the spacing
+            // estimated from the part), an element corner as a point.
+            const double spacing = part.type() == "PolyData" && diameter.empty() ? estimated_spacing(points, three_d, raw) : 0.0;
+            for (std::size_t i = 0; i < points.size(); ++i) {
+                const double d = diameter.empty() ? spacing : diameter[i] > 0.0 ? diameter[i] : spacing;
+                extend(points[i], 0.5 * d);
+            }
+        }
+    }
+    if (!(umin < umax) || !(vmin < vmax)) {
+        throw SnapshotError(fmt::format("{}: no snapshot has a point with a finite position to frame", series.pvd.string()));
+    }
+    return {umin, umax, vmin, vmax};
 }
 
 // --- PNG ---------------------------------------------------------------------------------------

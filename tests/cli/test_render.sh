@@ -45,6 +45,11 @@ expect 0 "render a region with units" -- "$gpa" render run --field pressure --re
 is_png region.png || fail "region.png is not a PNG"
 expect 0 "render the .pvd itself" -- "$gpa" render run/particles.pvd --field plastic_strain -o strain.png
 is_png strain.png || fail "strain.png is not a PNG"
+expect 0 "render with one frame for the run, a tensor component, no failure marks" -- \
+  "$gpa" render run --field stress:hoop --frame run --snapshot 0 --no-failed-marks -o framed.png
+is_png framed.png || fail "framed.png is not a PNG"
+expect 0 "render the bodies by name" -- "$gpa" render run --field body -o bodies.png
+is_png bodies.png || fail "bodies.png is not a PNG"
 expect 0 "list" -- "$gpa" render run --list
 for word in particles_00000.vtp particles_00001.vtp pressure von_mises_stress "axisymmetric (from scene.toml)"; do
   grep -qF "$word" out.txt || fail "--list lacks '$word': $(head -c 600 out.txt)"
@@ -78,6 +83,9 @@ refused "time not a time" "--time '3 mm'" run --time "3 mm"
 refused "range the wrong way" "must end above" run --field pressure --range 5:1
 refused "range without a colon" "--range '5'" run --field pressure --range 5
 refused "range of the wrong unit" "--range" run --field pressure --range "1 mm:2 mm"
+refused "frame not a word it knows" "--frame 'all'" run --frame all
+refused "frame and region" "excludes" run --frame run --region=-1mm:1mm,0:2mm
+refused "a whole tensor" "von_mises_stress" run --field stress
 refused "region without a comma" "--region '0:1'" run --region 0:1
 refused "region the wrong way" "must end above" run --region=1mm:0mm,0:1mm
 refused "region of the wrong unit" "--region" run --region "0:1 s,0:1"

@@ -443,6 +443,142 @@ TEST(Render, ANodeIsDrawnInItsFieldColourAtItsPixelAndTheBackgroundBetween) {
     EXPECT_EQ(r.range_max, 6.0);
 }
 
+TEST(Render, FailedNodesCarryABlackDotUnlessAskedNot) {
+    NodeStore n = three_nodes();
+    n.failed[1] = 1;
+    const LoadedSnapshot s = snapshot_of("failed_marks", n);
+    RenderOptions o;
+    o.field = "pressure";
+    const Picture p = render_snapshot(s, GeometryKind::PlaneStrain, o);
+    EXPECT_EQ(p.failed, 1u);
+    EXPECT_EQ(pixel_at(p, 3e-3, 1e-3), text_colour);                   // the dot at the failed node's centre
+    EXPECT_EQ(pixel_at(p, 3e-3 + 0.18e-3, 1e-3), colour_map(1.0));     // its field colour beyond the dot (r/3)
+    EXPECT_EQ(pixel_at(p, 1e-3, 1e-3), colour_map(0.0));               // an intact node: no dot
+    o.mark_failed = false;
+    const Picture plain = render_snapshot(s, GeometryKind::PlaneStrain, o);
+    EXPECT_EQ(plain.failed, 0u);
+    EXPECT_EQ(pixel_at(plain, 3e-3, 1e-3), colour_map(1.0));
+    // Coloured by `failed` itself: no dots, the field says it.
+    o.mark_failed = true;
+    o.field = "failed";
+    const Picture by_field = render_snapshot(s, GeometryKind::PlaneStrain, o);
+    EXPECT_EQ(by_field.failed, 0u);
+    EXPECT_EQ(pixel_at(by_field, 3e-3, 1e-3), colour_map(1.0));
+}
+
+TEST(Render, BodiesAndMaterialsAreCategoriesNamedByTheScene) {
+    NodeStore n = three_nodes();
+    n.body = {0, 2, 1};
+    const LoadedSnapshot s = snapshot_of("categories", n);
+    Scene scene;
+    scene.bodies.resize(3);
+    scene.bodies[0].name = "plate";
+    scene.bodies[1].name = "sphere";
+    scene.bodies[2].name = "backing";
+    RenderOptions o;
+    o.field = "body";
+    o.scene = &scene;
+    const Picture p = render_snapshot(s, GeometryKind::PlaneStrain, o);
+    EXPECT_TRUE(p.categorical);
+    EXPECT_EQ(pixel_at(p, 1e-3, 1e-3), category_colour(0));
+    EXPECT_EQ(pixel_at(p, 3e-3, 1e-3), category_colour(2));
+    EXPECT_EQ(pixel_at(p, 2e-3, 3e-3), category_colour(1));
+    // Seven colours a colour-blind reader tells apart, none of them the text's or the background's.
+    for (int k = 0; k < 7; ++k) {
+        for (int j = 0; j < k; ++j) EXPECT_NE(category_colour(k), category_colour(j));
+        EXPECT_NE(category_colour(k), text_colour);
+        EXPECT_NE(category_colour(k), background_colour);
+    }
+    EXPECT_EQ(category_colour(7), category_colour(0));
+    // A colour range asked for: the indices as numbers on the colour map.
+    o.range_min = 0.0;
+    o.range_max = 2.0;
+    const Picture q = render_snapshot(s, GeometryKind::PlaneStrain, o);
+    EXPECT_FALSE(q.categorical);
+    EXPECT_EQ(pixel_at(q, 3e-3, 1e-3), colour_map(1.0));
+}
+
+TEST(Render, TheScenesPlanesAreLinesWhereSeenEdgeOn) {
+    NodeStore n = three_nodes();
+    const LoadedSnapshot s = snapshot_of("planes", n);
+    Scene scene;
+    PlaneSpec anvil;
+    anvil.name = "anvil";
+    anvil.axis = 1;  // z in 2D
+    anvil.position = 0.5e-3;
+    scene.planes.push_back(anvil);
+    PlaneSpec symmetry;
+    symmetry.name = "mid";
+    symmetry.kind = PlaneKind::Symmetry;
+    symmetry.axis = 0;
+    symmetry.position = 2e-3;
+    scene.planes.push_back(symmetry);
+    RenderOptions o;
+    o.field = "pressure";
+    o.scene = &scene;
+    const Picture p = render_snapshot(s, GeometryKind::PlaneStrain, o);
+    EXPECT_EQ(p.planes_drawn, 2u);
+    // The anvil's line at z = 0.5 mm, across the drawing between the nodes.
+    EXPECT_EQ(pixel_at(p, 2e-3 - 0.6e-3, 0.5e-3), text_colour);
+    // The drawing reaches to a plane away from the bodies; outside a region asked for, a plane is
+    // not drawn; in 3D, one facing the viewer neither.
+    scene.planes[0].position = -2e-3;
+    const Picture reaching = render_snapshot(s, GeometryKind::PlaneStrain, o);
+    EXPECT_EQ(reaching.planes_drawn, 2u);
+    EXPECT_EQ(pixel_at(reaching, 2e-3 - 0.6e-3, -2e-3), text_colour);
+    o.region = std::array<double, 4>{0.0, 4e-3, 0.0, 4e-3};
+    EXPECT_EQ(render_snapshot(s, GeometryKind::PlaneStrain, o).planes_drawn, 1u);
+    o.region.reset();
+    NodeStore solid(GeometryKind::ThreeD, 2);
+    solid.position[0] = {0.0, 1e-3};
+    solid.position[1] = {0.0, 1e-3};
+    solid.position[2] = {1e-3, 2e-3};
+    solid.diameter = {0.5e-3, 0.5e-3};
+    const LoadedSnapshot s3 = snapshot_of("planes_3d", solid);
+    Scene scene_3d;
+    PlaneSpec floor;
+    floor.name = "floor";
+    floor.axis = 2;
+    floor.position = 1.2e-3;
+    scene_3d.planes.push_back(floor);
+    o.scene = &scene_3d;
+    EXPECT_EQ(render_snapshot(s3, GeometryKind::ThreeD, o).planes_drawn, 1u);  // +y: z is up
+    o.view = ViewDirection::MinusZ;
+    EXPECT_EQ(render_snapshot(s3, GeometryKind::ThreeD, o).planes_drawn, 0u);  // seen from above: faces the viewer
+}
+
+TEST(Render, OneFrameHoldsEverySnapshotOfARun) {
+    const fs::path dir = fresh_dir("series_extent");
+    SnapshotSeries series(dir);
+    NodeStore n(GeometryKind::Axisymmetric, 1);
+    n.diameter = {0.2e-3};
+    n.position[0] = {1e-3};
+    n.position[1] = {1e-3};
+    series.write(n, 1, 0.0);
+    n.position[0] = {2e-3};
+    n.position[1] = {5e-3};
+    series.write(n, 1, 1e-6);
+    const SnapshotIndex index = read_pvd(dir / "particles.pvd");
+    RenderOptions o;
+    // Mirrored about the axis (axisymmetric): -2.1 to 2.1 mm across, 0.9 to 5.1 mm up.
+    const auto e = series_extent(index, GeometryKind::Axisymmetric, o);
+    EXPECT_NEAR(e[0], -2.1e-3, 1e-15);
+    EXPECT_NEAR(e[1], 2.1e-3, 1e-15);
+    EXPECT_NEAR(e[2], 0.9e-3, 1e-15);
+    EXPECT_NEAR(e[3], 5.1e-3, 1e-15);
+    o.mirror = false;
+    EXPECT_NEAR(series_extent(index, GeometryKind::Axisymmetric, o)[0], 0.9e-3, 1e-15);
+    // Passed as the region, the first snapshot is drawn in the frame of the whole run: its
+    // node sits in the lower left of a picture as tall as the run's path.
+    o.region = e;
+    o.mirror.reset();
+    const Picture first = render_snapshot(load_snapshot(index, 0), GeometryKind::Axisymmetric, o);
+    const Picture last = render_snapshot(load_snapshot(index, 1), GeometryKind::Axisymmetric, o);
+    EXPECT_EQ(first.image.height, last.image.height);
+    EXPECT_EQ(first.frame.scale, last.frame.scale);
+    EXPECT_EQ(first.frame.u_left, last.frame.u_left);
+}
+
 TEST(Render, PicturesTakeTheSizeAskedForOrTheScenesProportions) {
     RenderOptions o;
     o.field = "pressure";

@@ -8,8 +8,9 @@
 // orthographic projection along a coordinate axis, the discs drawn from the farthest to the
 // nearest (painter's order). Element bodies (the .vtu parts of the same snapshot) are drawn as
 // filled triangles, coloured by their cell field, or by their point field interpolated across
-// the triangle. The picture carries a colour bar with the field's name, unit and range, the
-// snapshot's time, and a length scale.
+// the triangle. The picture carries a colour bar with the field's name, unit and range (a legend
+// of names for body and material), the snapshot's time, coordinates along both axes, the scene's
+// planes and a mark on every failed node.
 
 #include <array>
 #include <cstddef>
@@ -21,6 +22,7 @@
 #include <vector>
 
 #include "gpa/engine/geometry.hpp"
+#include "gpa/engine/scene.hpp"
 #include "gpa/io/snapshot_reader.hpp"
 
 namespace gpa::io {
@@ -93,7 +95,13 @@ struct RenderOptions {
     // picture's own axes (2D: x and z; 3D: the view's right and up); the colour range and the
     // counts then cover only what lies in it. Default: the whole snapshot.
     std::optional<std::array<double, 4>> region;
-    std::string title;                                // drawn at the top (e.g. the run's name)
+    std::string title;                                // drawn at the top (e.g. the scene's name)
+    // The run's scene (its scene.toml), when known: the names in the legends of `body` and
+    // `material`, and the rigid and symmetry planes, drawn as lines where they are seen edge-on.
+    const Scene* scene = nullptr;
+    // Failed nodes and cells (a snapshot's `failed` array) get a black dot at their centre, in
+    // every field but `failed` itself.
+    bool mark_failed = true;
 };
 inline constexpr int min_width = 200, min_height = 150, max_side = 8192;
 
@@ -142,7 +150,21 @@ struct Picture {
     std::size_t not_finite_positions = 0;     // left out
     std::size_t without_field = 0;            // nodes and cells of parts without the field (grey)
     std::size_t below_range = 0, above_range = 0;
+    std::size_t failed = 0;                   // nodes and cells marked failed (a mirrored node counts once)
+    bool categorical = false;                 // body or material: a colour and a name per value, no colour bar
+    std::size_t planes_drawn = 0;             // scene planes drawn as lines
 };
+
+// The colour of category k (a body or material index) in pictures coloured by `body` or
+// `material`: seven colours that colour-blind readers tell apart (Okabe and Ito's, less black),
+// repeated.
+Rgb category_colour(long long k);
+
+// The picture-plane window {left, right, bottom, top} (m) holding every snapshot of a series as
+// render_snapshot would draw it (discs with their diameters, mirrored 2D runs with their mirror
+// image): passed as RenderOptions::region, it keeps one frame for every snapshot of a run, so
+// that a body's motion shows. Throws SnapshotError for a file that cannot be read.
+std::array<double, 4> series_extent(const SnapshotIndex& series, GeometryKind geometry, const RenderOptions& options);
 
 // Draws the snapshot. Throws InputError for an unknown field (listing the snapshot's fields), a
 // component of a scalar field, a size outside the limits above, a range with min >= max, mirror
