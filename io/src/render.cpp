@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <map>
 #include <cstring>
 #include <limits>
 
@@ -350,6 +351,7 @@ struct Disc {
     double value;
     bool has_value;
     bool failed = false;
+    int region = 0;  // 0 free; k + 1 held by the scene's prescribed velocity k
 };
 
 struct Triangle {
@@ -556,6 +558,10 @@ Picture render_snapshot(const LoadedSnapshot& snapshot, GeometryKind geometry, c
             if (const VtkArrayInfo* f = part.find("failed", at); f && f->components == 1) failed = part.values("failed", at);
         }
         if (part.type() == "PolyData") {
+            std::vector<double> held;
+            if (const VtkArrayInfo* h = part.find("prescribed_velocity", DataLocation::Point); h && h->components == 1) {
+                held = part.values("prescribed_velocity", DataLocation::Point);
+            }
             std::vector<double> diameter;
             if (const VtkArrayInfo* d = part.find("diameter", DataLocation::Point); d && d->components == 1) {
                 diameter = part.values("diameter", DataLocation::Point);
@@ -569,7 +575,8 @@ Picture render_snapshot(const LoadedSnapshot& snapshot, GeometryKind geometry, c
                 const double d = diameter.empty() || !(diameter[i] > 0.0) || !std::isfinite(diameter[i]) ? spacing : diameter[i];
                 const double value = field ? field->values[i] : 0.0;
                 discs.push_back({points[i].u, points[i].v, 0.5 * (d > 0.0 ? d : spacing), points[i].depth, value, field.has_value(),
-                                 !failed.empty() && failed[i] != 0.0});
+                                 !failed.empty() && failed[i] != 0.0,
+                                 held.empty() || !(held[i] >= 1.0 && held[i] <= 255.0) ? 0 : static_cast<int>(held[i])});
                 if (!field) ++picture.without_field;
             }
         } else {
@@ -961,6 +968,47 @@ Picture render_snapshot(const LoadedSnapshot& snapshot, GeometryKind geometry, c
             draw_text(img, plot.x1 - name_w - s, y, label, s, text_colour);
         }
         ++picture.planes_drawn;
+    }
+
+    // Prescribed-velocity regions: a dashed rectangle around the nodes each holds (its mirror
+    // image too), with the region's name (the scene's, or "region k") above it.
+    std::map<int, std::array<double, 4>> held_boxes;  // region -> {umin, umax, vmin, vmax}
+    for (const auto& d : discs) {
+        if (d.region == 0) continue;
+        const int key = d.u < 0.0 && mirror ? -d.region : d.region;  // a mirror image has a box of its own
+        auto [it, fresh] = held_boxes.try_emplace(key, std::array<double, 4>{d.u - d.radius, d.u + d.radius, d.v - d.radius, d.v + d.radius});
+        if (!fresh) {
+            auto& b = it->second;
+            b = {std::min(b[0], d.u - d.radius), std::max(b[1], d.u + d.radius), std::min(b[2], d.v - d.radius), std::max(b[3], d.v + d.radius)};
+        }
+    }
+    for (const auto& [key, box] : held_boxes) {
+        const auto [x0, y0] = frame.pixel(box[0], box[3]);
+        const auto [x1, y1] = frame.pixel(box[1], box[2]);
+        const int l = static_cast<int>(std::floor(x0)) - 2 * s, r = static_cast<int>(std::ceil(x1)) + 2 * s;
+        const int t = static_cast<int>(std::floor(y0)) - 2 * s, b = static_cast<int>(std::ceil(y1)) + 2 * s;
+        const auto dash = [&](int q, int from) { return ((q - from) / (4 * s)) % 2 == 0; };
+        for (int x = l; x <= r; ++x) {
+            if (!dash(x, l) || x < plot.x0 || x >= plot.x1) continue;
+            for (const int y : {t, b}) {
+                if (y >= plot.y0 && y < plot.y1) fill_rect(img, x, y, x + 1, y + std::max(s, 1), text_colour);
+            }
+        }
+        for (int y = t; y <= b; ++y) {
+            if (!dash(y, t) || y < plot.y0 || y >= plot.y1) continue;
+            for (const int x : {l, r}) {
+                if (x >= plot.x0 && x < plot.x1) fill_rect(img, x, y, x + std::max(s, 1), y + 1, text_colour);
+            }
+        }
+        const int k = std::abs(key) - 1;
+        const Scene* scene = options.scene;
+        const std::string name = scene && static_cast<std::size_t>(k) < scene->prescribed_velocities.size()
+                                     ? scene->prescribed_velocities[static_cast<std::size_t>(k)].name
+                                     : fmt::format("region {}", k);
+        const std::string label = fitted(name, std::max(r - l, detail::text_width("m...", s)), s);
+        draw_text(img, std::clamp(l, plot.x0, std::max(plot.x0, plot.x1 - detail::text_width(label, s))),
+                  t - text_h - s >= plot.y0 ? t - text_h - s : b + 2 * s, label, s, text_colour);
+        ++picture.regions_drawn;
     }
 
     // Text at the top: the title and mark, then the field, its unit and the time.

@@ -123,6 +123,9 @@ void write_vtp(const std::filesystem::path& path, const NodeStore& nodes, std::s
             case SnapshotField::Material:
                 arrays.push_back({"material", "Int32", 1, data.add_int32(count, [&](std::size_t i) { return nodes.material[i]; })});
                 break;
+            case SnapshotField::PrescribedVelocity:
+                arrays.push_back({"prescribed_velocity", "UInt8", 1, data.add_uint8(count, [&](std::size_t i) { return nodes.velocity_region[i]; })});
+                break;
         }
     }
     // The node ids (node_store.hpp): the same node in every snapshot, whatever the run's reordering.

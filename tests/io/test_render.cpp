@@ -547,6 +547,31 @@ TEST(Render, TheScenesPlanesAreLinesWhereSeenEdgeOn) {
     EXPECT_EQ(render_snapshot(s3, GeometryKind::ThreeD, o).planes_drawn, 0u);  // seen from above: faces the viewer
 }
 
+TEST(Render, PrescribedVelocityRegionsAreOutlinedAroundTheirNodes) {
+    NodeStore n = three_nodes();
+    n.velocity_region = {1, 1, 0};  // the two lower nodes held by region 0
+    const LoadedSnapshot s = snapshot_of("regions", n);
+    RenderOptions o;
+    o.field = "pressure";
+    const Picture p = render_snapshot(s, GeometryKind::PlaneStrain, o);
+    EXPECT_EQ(p.regions_drawn, 1u);
+    // The box's lower edge runs two font pixels (up to 8 picture pixels) below the held discs
+    // (z = 1 mm less 0.25 mm), dashed: a row there between the nodes is partly dark.
+    const auto [x0, y] = p.frame.pixel(1e-3, 0.75e-3);
+    const auto [x1, unused] = p.frame.pixel(3e-3, 0.75e-3);
+    int darkest_row = 0;
+    for (int row = static_cast<int>(y); row <= static_cast<int>(y) + 8; ++row) {
+        int dark = 0;
+        for (int x = static_cast<int>(x0); x < static_cast<int>(x1); ++x) dark += p.image.at(x, row) == text_colour;
+        darkest_row = std::max(darkest_row, dark);
+    }
+    // Half of a dashed edge is drawn (dashes as long as the gaps).
+    EXPECT_GT(darkest_row, static_cast<int>(0.3 * (x1 - x0)));
+    EXPECT_EQ(pixel_at(p, 2e-3, 3e-3), colour_map(0.5));
+    // Mirrored (axisymmetric): the image has its own box.
+    EXPECT_EQ(render_snapshot(s, GeometryKind::Axisymmetric, o).regions_drawn, 2u);
+}
+
 TEST(Render, OneFrameHoldsEverySnapshotOfARun) {
     const fs::path dir = fresh_dir("series_extent");
     SnapshotSeries series(dir);

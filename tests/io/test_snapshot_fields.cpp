@@ -277,6 +277,7 @@ std::vector<Expected> expected_particles(const NodeStore& n, bool float32) {
     one("connectivity", "UInt8", [&](std::size_t i) { return n.connectivity[i] == Connectivity::Variable ? 1.0 : 0.0; });
     one("body", "Int32", [&](std::size_t i) { return double(n.body[i]); });
     one("material", "Int32", [&](std::size_t i) { return double(n.material[i]); });
+    one("prescribed_velocity", "UInt8", [&](std::size_t i) { return double(n.velocity_region[i]); });
     one("id", "Int64", [&](std::size_t i) { return double(n.id[i]); });
     vec("", [&](int c, std::size_t i) { return n.position[c][i]; });
     return out;
@@ -379,6 +380,7 @@ TEST(SnapshotFiles, EveryFieldHoldsItsNodeValuesInBothPrecisions) {
         n.connectivity[2] = Connectivity::Fixed;
         n.body[3] = 1;
         n.material[3] = 2;
+        n.velocity_region[3] = 1;
         EXPECT_GT(*std::max_element(n.plastic_strain.begin(), n.plastic_strain.end()), 0.0);
     }
     ASSERT_TRUE(elements.elements.has_value());

@@ -34,6 +34,7 @@ constexpr FieldName field_names[] = {
     {SnapshotField::Connectivity, "connectivity"},
     {SnapshotField::Body, "body"},
     {SnapshotField::Material, "material"},
+    {SnapshotField::PrescribedVelocity, "prescribed_velocity"},
 };
 
 }  // namespace

@@ -32,6 +32,7 @@ enum class SnapshotField : std::uint8_t {
     Connectivity,      // 1 variable, 0 fixed (UInt8)
     Body,              // index of the scene's body (Int32)
     Material,          // index of the scene's material (Int32)
+    PrescribedVelocity,  // 0 free; k + 1 held by the scene's [[prescribed_velocity]] k (UInt8)
 };
 
 enum class SnapshotPrecision : std::uint8_t { Float64, Float32 };

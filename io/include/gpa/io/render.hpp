@@ -153,6 +153,7 @@ struct Picture {
     std::size_t failed = 0;                   // nodes and cells marked failed (a mirrored node counts once)
     bool categorical = false;                 // body or material: a colour and a name per value, no colour bar
     std::size_t planes_drawn = 0;             // scene planes drawn as lines
+    std::size_t regions_drawn = 0;            // prescribed-velocity regions outlined (a mirror image counts)
 };
 
 // The colour of category k (a body or material index) in pictures coloured by `body` or
