@@ -1,7 +1,8 @@
 // gpa: high-velocity impact simulation with the Generalized Particle Algorithm.
 //   gpa run [SCENE] [-o DIR] [--threads N] [--overwrite] [--quiet] [--max-memory SIZE]
 //   gpa run --resume DIR [--threads N] [--quiet] [--max-memory SIZE]
-//   gpa study SCENE [-o DIR] [--refine 1,1.5,2] [--variant NAME:key=value,...]... [--threads 1,2] [--overwrite] [-q]
+//   gpa study SCENE [-o DIR] [--refine 1,1.5,2] [--variant NAME:key=value,...]... [--threads 1,2] [--metrics a,b]
+//             [--overwrite] [-q]
 //             [--reference FILE]
 //   gpa check SCENE [--max-memory SIZE]
 //   gpa render RUN_DIR [--field NAME[:x|y|z|xx|...]] [-o PNG] [--snapshot N|last | --time T] [--size WxH | --width W]
@@ -136,6 +137,9 @@ int main(int argc, char** argv) {
         ->expected(1)
         ->take_all();
     study->add_option("--threads", study_options.threads, "thread counts, e.g. 1,2 (0 = all hardware threads; default 0)");
+    study->add_option("--metrics", study_options.metrics,
+                      "the metrics to analyse and plot, e.g. crater_depth,residual_velocity (default: every metric the runs produce; "
+                      "docs/study.md lists them)");
     study->add_flag("--overwrite", study_options.overwrite, "replace an existing output folder when the study ends");
     std::string study_reference;
     study->add_option("--reference", study_reference,

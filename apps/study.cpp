@@ -160,6 +160,7 @@ int run_study(const StudyOptions& options) {
     if (!reference_warning.empty()) spdlog::warn("{}", reference_warning);
     log_scene_warnings(scene, options.scene.string());
     const std::vector<double> factors = io::parse_refinements(options.refine);
+    const std::vector<std::string> chosen_metrics = options.metrics.empty() ? std::vector<std::string>{} : io::parse_metric_list(options.metrics);
     const std::vector<int> thread_counts = io::parse_thread_counts(options.threads);
     std::vector<io::Variant> variants;
     for (const auto& text : options.variants) variants.push_back(io::parse_variant(text));
@@ -250,6 +251,7 @@ int run_study(const StudyOptions& options) {
     report.scene_description = scene.description;
     report.refinements = factors;
     report.variants = variants;
+    report.chosen_metrics = chosen_metrics;
     report.reference = scene.reference;
     report.reference_source = scene.reference_source;
     // A reference that is not there was a warning above: the study is not compared with it.

@@ -17,6 +17,7 @@ struct StudyOptions {
     std::string refine = "1,1.5,2";               // refinement factors, as typed
     std::vector<std::string> variants;            // NAME[:key=value,...] as typed; none: the scene as written
     std::string threads = "0";                    // thread counts, as typed
+    std::string metrics;                          // --metrics a,b: the metrics analysed; "": every one the runs produce
     bool overwrite = false;
     bool quiet = false;
     MemoryLimit memory;  // --max-memory, for every case

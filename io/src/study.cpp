@@ -445,6 +445,12 @@ const std::vector<MetricInfo>& study_metrics() {
         {"footprint_diameter", "m", "mm", 1e3, true, "width of the body on the first rigid plane at the end (docs/measurement.md)"},
         {"contact_time", "s", "us", 1e6, true, "time from the onset of contact with the first rigid plane to lift-off"},
         {"rebound_speed", "m/s", "m/s", 1.0, true, "|momentum along the plane normal| / mass after lift-off"},
+        {"crater_depth", "m", "mm", 1e3, true,
+         "depth of the first target's crater along the impact axis at the end, its thickness there if perforated (docs/measurement.md)"},
+        {"crater_diameter", "m", "mm", 1e3, true, "diameter of the first target's crater at its front face at the end (docs/measurement.md)"},
+        {"residual_velocity", "m/s", "m/s", 1.0, true,
+         "centre-of-mass velocity of the main piece of the first body moving at t = 0 (the projectile) along the impact axis at the end "
+         "(docs/measurement.md)"},
         {"plastic_work", "J", "J", 1.0, true, "plastic work at the end"},
         {"peak_plastic_strain", "", "", 1.0, true,
          "largest mean equivalent plastic strain over a neighbourhood of the scene's peak_radius at the end (docs/measurement.md)"},
@@ -464,6 +470,27 @@ const MetricInfo* find_study_metric(std::string_view key) {
         if (m.key == key) return &m;
     }
     return nullptr;
+}
+
+std::vector<std::string> parse_metric_list(std::string_view text) {
+    std::vector<std::string> out;
+    std::string known;
+    for (const auto& m : study_metrics()) known += (known.empty() ? "" : ", ") + m.key;
+    std::size_t start = 0;
+    while (start <= text.size()) {
+        const std::size_t comma = std::min(text.find(',', start), text.size());
+        std::string word(text.substr(start, comma - start));
+        word.erase(0, word.find_first_not_of(' '));
+        word.erase(word.find_last_not_of(' ') + 1);
+        if (word.empty()) throw InputError(fmt::format("--metrics '{}': an empty name; the metrics are {}", text, known));
+        if (!find_study_metric(word)) throw InputError(fmt::format("--metrics '{}': no metric '{}'; the metrics are {}", text, word, known));
+        if (std::find(out.begin(), out.end(), word) != out.end()) {
+            throw InputError(fmt::format("--metrics '{}': '{}' is named twice", text, word));
+        }
+        out.push_back(word);
+        start = comma + 1;
+    }
+    return out;
 }
 
 RunProbe::RunProbe(const Simulation& sim) {
@@ -509,6 +536,15 @@ std::map<std::string, double> RunProbe::metrics(const Simulation& sim) const {
         m["peak_radius"] = t.local.radius;  // not a study metric: tells the reference comparison the neighbourhood
         if (t.local.face_points >= 3) m["face_roughness"] = t.local.face_roughness;
     }
+    // A projectile and a target (body_report.hpp): measured when some body moves and another is at
+    // rest at t = 0, as of the caller's measure_bodies().
+    const auto target = std::find_if(t.bodies.begin(), t.bodies.end(), [](const BodyTotals& b) { return b.measured && b.target; });
+    if (target != t.bodies.end()) {
+        m["crater_depth"] = target->crater_depth;
+        m["crater_diameter"] = target->crater_diameter;
+        const auto projectile = std::find_if(t.bodies.begin(), t.bodies.end(), [](const BodyTotals& b) { return b.measured && !b.target; });
+        if (projectile != t.bodies.end()) m["residual_velocity"] = projectile->residual_speed_along_axis;
+    }
     if (plane_ < 0) return m;
     const bool left = lift_off_ && contact_start_ >= 0.0 && !touching_ && contact_end_ >= 0.0;
     if (left) {
@@ -533,6 +569,8 @@ StudyAnalysis analyse_study(const StudyReport& report) {
             const double v = metric_value(c, m.key);
             if (std::isfinite(v) && v != 0.0) produced = true;
         }
+        const auto& chosen = report.chosen_metrics;
+        if (!chosen.empty() && std::find(chosen.begin(), chosen.end(), m.key) == chosen.end()) continue;
         if (produced) a.metrics.push_back(m.key);
     }
     for (const auto& c : report.cases) {
@@ -670,7 +708,7 @@ void write_study_markdown(const fs::path& file, const StudyReport& report, const
         if (!m->analysed) continue;
         const auto ref = report.reference.find(key);
         const bool has_ref = ref != report.reference.end();
-        s += fmt::format("\n## {} ({})\n\n{}", key, m->display_unit, m->description);
+        s += fmt::format("\n## {}{}\n\n{}", key, m->display_unit.empty() ? "" : fmt::format(" ({})", m->display_unit), m->description);
         if (has_ref) s += fmt::format("; the scene's answer {:.6g} {}", ref->second * m->display_scale, m->display_unit);
         s += ".\n\n";
         s += fmt::format("| series | refinement | cell mm | wall s | node-steps/s | peak MB | B/node | {} {} | discretisation "
@@ -798,6 +836,8 @@ LogLogFigure error_figure(const StudyReport& report, const StudyAnalysis& analys
             }
             panel.series.push_back(std::move(points));
         }
+        // A panel with no point at all says nothing: study.md gives each metric's status.
+        if (missing.size() == analysis.series.size()) continue;
         if (!missing.empty()) {
             panel.note = "no points: ";
             for (std::size_t k = 0; k < missing.size(); ++k) panel.note += (k ? ", " : "") + missing[k];
@@ -814,12 +854,20 @@ std::vector<fs::path> write_study_plots(const fs::path& folder, const StudyRepor
     for (const auto& key : analysis.metrics) {
         if (find_study_metric(key)->analysed && report.reference.count(key)) any_reference = true;
     }
+    // A figure without a panel (no metric has an error to draw: fewer than three resolutions, or
+    // nothing measured) is not written.
     std::vector<fs::path> written;
-    write_loglog_svg(folder / "error_vs_time.svg", error_figure(report, analysis, any_reference));
-    written.push_back(folder / "error_vs_time.svg");
+    const LogLogFigure main = error_figure(report, analysis, any_reference);
+    if (!main.panels.empty()) {
+        write_loglog_svg(folder / "error_vs_time.svg", main);
+        written.push_back(folder / "error_vs_time.svg");
+    }
     if (any_reference) {
-        write_loglog_svg(folder / "discretisation_error_vs_time.svg", error_figure(report, analysis, false));
-        written.push_back(folder / "discretisation_error_vs_time.svg");
+        const LogLogFigure discretisation = error_figure(report, analysis, false);
+        if (!discretisation.panels.empty()) {
+            write_loglog_svg(folder / "discretisation_error_vs_time.svg", discretisation);
+            written.push_back(folder / "discretisation_error_vs_time.svg");
+        }
     }
     return written;
 }

@@ -202,6 +202,7 @@ study_refused() {
 study_refused "refine not a number" "--refine '1,x'" --refine 1,x
 study_refused "refine twice" "listed twice" --refine 1,2,1
 study_refused "refine zero" "positive refinement factor" --refine 0,1
+study_refused "an unknown metric" "no metric 'length'" --metrics length
 study_refused "threads" "--threads" --threads 1,-1
 study_refused "reference from two series" "--reference" --refine 1,1.5,2 --variant a --variant b:weight=sph-nsf --reference r.toml
 study_refused "reference from two resolutions" "--reference" --refine 1,2 --reference r.toml

@@ -335,6 +335,57 @@ TEST(RunProbe, ABarHeldOnThePlaneHasALengthAndAFootprint) {
     EXPECT_GT(m.at("footprint_diameter"), 1.5e-3);
 }
 
+// A projectile and a target: the crater and the residual velocity, and no Taylor metrics (no
+// rigid plane); a bar on its anvil has no crater metrics (nothing at rest).
+TEST(RunProbe, AProjectileAndATargetHaveACraterAndAResidualVelocity) {
+    const std::string impact = R"toml(
+name = "impact"
+geometry = "axisymmetric"
+[[body]]
+name = "plate"
+shape = "cylinder"
+material = "OFHC copper"
+radius = "3 mm"
+length = "1 mm"
+spacing = "0.25 mm"
+[[body]]
+name = "rod"
+shape = "cylinder"
+material = "OFHC copper"
+origin = [0, "1 mm"]
+radius = "0.5 mm"
+length = "1 mm"
+spacing = "0.25 mm"
+velocity = [0, "-1000 m/s"]
+[stop]
+end_time = "0.3 us"
+)toml";
+    Simulation sim(io::parse_scene(impact, "impact.toml"), 1);
+    RunProbe probe(sim);
+    while (!sim.finished()) {
+        sim.step();
+        probe.observe(sim);
+    }
+    sim.measure_bodies();
+    const auto m = probe.metrics(sim);
+    ASSERT_TRUE(m.count("crater_depth"));
+    ASSERT_TRUE(m.count("crater_diameter"));
+    ASSERT_TRUE(m.count("residual_velocity"));
+    // 0.3 us after a 1 km/s impact: the rod has slowed (a copper-on-copper impact halves the speed
+    // at the interface) but still moves into the plate, which has a dent: at most the rod's travel,
+    // 0.3 mm, plus a node's reach (d/2 = 0.125 mm) by which the rule measures it.
+    EXPECT_GT(m.at("residual_velocity"), 0.0);
+    EXPECT_LT(m.at("residual_velocity"), 1000.0);
+    EXPECT_GT(m.at("crater_depth"), 0.0);
+    EXPECT_LT(m.at("crater_depth"), 0.3e-3 + 0.125e-3);
+    EXPECT_FALSE(m.count("final_length"));
+    EXPECT_FALSE(m.count("contact_time"));
+    Simulation bar(bar_scene(false), 1);
+    for (int k = 0; k < 5; ++k) bar.step();
+    bar.measure_bodies();
+    EXPECT_FALSE(RunProbe(bar).metrics(bar).count("crater_depth"));
+}
+
 // scenes/elastic-bar.toml states its answers from its own material and size: Poisson's ratio 0,
 // contact time 2 L / c with the bar speed c = sqrt(E / rho), rebound at the impact speed.
 TEST(RunProbe, TheElasticBarSceneStatesTheAnswersOfItsOwnNumbers) {
@@ -436,6 +487,61 @@ TEST(StudyOutputs, CsvMarkdownAndPlotsAreWritten) {
     EXPECT_EQ(svg.find("</svg>"), svg.size() - 7);
     const std::string disc = read_text(dir / "discretisation_error_vs_time.svg");
     EXPECT_NE(disc.find("b (not monotone)"), std::string::npos) << "the series without a limit is named";
+    // A unitless metric's heading has no empty parentheses.
+    StudyReport strain = r;
+    for (auto& c : strain.cases) c.metrics["peak_plastic_strain"] = 1.0 + c.cell_size;
+    write_study_markdown(dir / "strain.md", strain, analyse_study(strain));
+    const std::string strain_md = read_text(dir / "strain.md");
+    EXPECT_NE(strain_md.find("## peak_plastic_strain\n"), std::string::npos);
+    EXPECT_EQ(strain_md.find("()"), std::string::npos);
+    std::filesystem::remove_all(dir);
+}
+
+TEST(StudyOutputs, MetricsChosenByNameAreTheOnlyOnesAnalysed) {
+    EXPECT_EQ(parse_metric_list("crater_depth, residual_velocity"), (std::vector<std::string>{"crater_depth", "residual_velocity"}));
+    for (const auto& [text, fragment] : std::vector<std::pair<std::string, std::string>>{
+             {"crater_dept", "no metric 'crater_dept'; the metrics are final_length,"},
+             {"final_length,,plastic_work", "an empty name"},
+             {"plastic_work,plastic_work", "'plastic_work' is named twice"}}) {
+        try {
+            parse_metric_list(text);
+            ADD_FAILURE() << text << " was accepted";
+        } catch (const InputError& e) {
+            EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
+        }
+    }
+    StudyReport r = synthetic_report();
+    for (auto& c : r.cases) c.metrics["plastic_work"] = 1.0 + c.cell_size;
+    EXPECT_EQ(analyse_study(r).metrics, (std::vector<std::string>{"final_length", "plastic_work", "energy_error"}));
+    r.chosen_metrics = {"plastic_work"};
+    EXPECT_EQ(analyse_study(r).metrics, (std::vector<std::string>{"plastic_work"}));
+}
+
+TEST(StudyOutputs, PanelsWithoutAPointAndFiguresWithoutAPanelAreLeftOut) {
+    const auto dir = std::filesystem::temp_directory_path() / "gpa_test_study_panels";
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+    // Series a converges in final_length; the plastic work is not monotone in either series: its
+    // panel of the discretisation error would have no point and is left out.
+    StudyReport r = synthetic_report();
+    r.reference.clear();
+    for (auto& c : r.cases) c.metrics["plastic_work"] = c.refinement == 2.0 ? 2.0 : 1.0;
+    const auto a = analyse_study(r);
+    const auto plots = write_study_plots(dir, r, a);
+    ASSERT_EQ(plots.size(), 1u);
+    const std::string svg = read_text(dir / "error_vs_time.svg");
+    EXPECT_NE(svg.find("final_length"), std::string::npos);
+    EXPECT_EQ(svg.find("plastic_work"), std::string::npos);
+    EXPECT_EQ(svg.find("no points to draw"), std::string::npos);
+    // Two resolutions: no metric has a discretisation error, so no figure at all.
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+    StudyReport two = synthetic_report();
+    two.reference.clear();
+    std::erase_if(two.cases, [](const StudyCase& c) { return c.refinement == 4.0; });
+    two.refinements = {1.0, 2.0};
+    EXPECT_TRUE(write_study_plots(dir, two, analyse_study(two)).empty());
+    EXPECT_FALSE(std::filesystem::exists(dir / "error_vs_time.svg"));
     std::filesystem::remove_all(dir);
 }
 

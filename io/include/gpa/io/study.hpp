@@ -140,10 +140,14 @@ struct MetricInfo {
 };
 
 // Every metric a study may report, in table order: final_length, footprint_diameter,
-// contact_time, rebound_speed, plastic_work, peak_plastic_strain, peak_temperature, face_roughness,
+// contact_time, rebound_speed, crater_depth, crater_diameter, residual_velocity, plastic_work,
+// peak_plastic_strain, peak_temperature, face_roughness,
 // energy_error, variable_fraction, hourglass_work.
 const std::vector<MetricInfo>& study_metrics();
 const MetricInfo* find_study_metric(std::string_view key);
+// The metrics a comma-separated list names ("crater_depth,residual_velocity"), each once; throws
+// InputError naming the option, the word and the metrics there are.
+std::vector<std::string> parse_metric_list(std::string_view text);
 
 // Follows a run step by step and gives its metrics at the end:
 //   final_length, footprint_diameter: Totals.length and .footprint_diameter when the scene has a
@@ -154,6 +158,9 @@ const MetricInfo* find_study_metric(std::string_view key);
 //     it and then left it for good: the time from the onset of contact to its end (each placed
 //     half way between the last step on one side and the first on the other) and
 //     |momentum along the plane normal| / total mass at the end of the run;
+//   crater_depth, crater_diameter, residual_velocity: when a body is at rest at t = 0 and another
+//     moves (the first target's crater, the first moving body's residual speed along the impact
+//     axis; body_report.hpp), as of the caller's Simulation::measure_bodies();
 //   plastic_work (J), energy_error (relative), variable_fraction (share of the real nodes with
 //     variable connectivity), hourglass_work (J): from the final totals.
 // A metric that does not apply is absent from the map.
@@ -202,6 +209,7 @@ struct StudyReport {
     std::string scene_description;
     std::vector<double> refinements;                 // ascending
     std::vector<Variant> variants;
+    std::vector<std::string> chosen_metrics;         // --metrics: analysed and plotted; empty: every metric produced
     std::map<std::string, double> reference;         // the scene's [reference]
     std::string reference_source;
     std::string memory_note;                         // how peak memory was measured
@@ -234,8 +242,9 @@ void write_study_csv(const std::filesystem::path& file, const StudyReport& repor
 void write_study_markdown(const std::filesystem::path& file, const StudyReport& report, const StudyAnalysis& analysis);
 
 // The error plots: error_vs_time.svg (the error against the scene's answers where it states
-// some, else the discretisation error) and, when both exist, discretisation_error_vs_time.svg.
-// Returns the files written.
+// some, else the discretisation error) and, when both exist, discretisation_error_vs_time.svg;
+// a panel per metric with a point to draw, and no file for a figure without one. Returns the
+// files written.
 std::vector<std::filesystem::path> write_study_plots(const std::filesystem::path& folder, const StudyReport& report,
                                                      const StudyAnalysis& analysis);
 
