@@ -298,10 +298,11 @@ void print_report(const Simulation& sim) {
                    100.0 * c.relative_error);
     }
     if (t.local.measured && t.local.plastic_strain.points > 0) {
-        fmt::print("  peak plastic strain {:.4g} (mean within {:.3g} mm) at ({:.3g}, {:.3g}) mm, largest single value {:.4g}; "
-                   "peak temperature {:.4g} K\n",
-                   t.local.plastic_strain.value, t.local.radius * 1e3, t.local.plastic_strain.position[0] * 1e3,
-                   t.local.plastic_strain.position[dim - 1] * 1e3, t.local.plastic_strain.raw, t.local.temperature.value);
+        const auto& at = t.local.plastic_strain.position;
+        const std::string where = dim == 3 ? fmt::format("(x, y, z) = ({:.3g}, {:.3g}, {:.3g}) mm", at[0] * 1e3, at[1] * 1e3, at[2] * 1e3)
+                                           : fmt::format("(x, z) = ({:.3g}, {:.3g}) mm", at[0] * 1e3, at[1] * 1e3);
+        fmt::print("  peak plastic strain {:.4g} (mean within {:.3g} mm) at {}, largest single value {:.4g}; peak temperature {:.4g} K\n",
+                   t.local.plastic_strain.value, t.local.radius * 1e3, where, t.local.plastic_strain.raw, t.local.temperature.value);
     }
     if (!sim.scene().element_reference.empty()) {
         try {

@@ -557,13 +557,13 @@ void ElementPart::update_stress_in(double dt, std::size_t step, double time) {
     }
     const auto where = [&](std::size_t i) {
         const std::size_t q = i / 4;
-        return fmt::format("element {} (the `element` of elements_*.vtu; triangle {} of its four) of body \"{}\" at step {}, t = {:.6g} us", q, i % 4,
+        return fmt::format("element {} (triangle {} of its four) of body \"{}\" at step {}, t = {:.6g} us", q, i % 4,
                            scene_.bodies.at(static_cast<std::size_t>(m.quads.body[q])).name, step, 1e6 * time);
     };
     if (inverted.any()) {
         const std::size_t q = inverted.index() / 4;
         throw NumericalError(fmt::format(
-            "{} inverted: {}; its nodes (corners, then centre; the ids of elements_*.vtu): {}. The mesh has tangled there; remedies: a smaller "
+            "{} inverted: {}; its nodes (corners, then centre; element and node numbers are the `element` and `id` arrays of elements_*.vtu): {}. The mesh has tangled there; remedies: a smaller "
             "solver.cfl, a finer or more even mesh (spacing, spacing_z), more artificial viscosity "
             "(solver.viscosity_linear, solver.viscosity_quadratic), or particles (discretisation = \"particles\") for a "
             "body that deforms this much",
@@ -571,7 +571,7 @@ void ElementPart::update_stress_in(double dt, std::size_t step, double time) {
     }
     if (failed.any()) {
         const std::size_t i = failed.index();
-        throw NumericalError(fmt::format("{}, material \"{}\": {}; its nodes (the ids of elements_*.vtu): {}", where(i),
+        throw NumericalError(fmt::format("{}, material \"{}\": {}; its nodes (element and node numbers are the `element` and `id` arrays of elements_*.vtu): {}", where(i),
                                          scene_.materials.at(static_cast<std::size_t>(m.quads.material[i / 4])).name,
                                          failed.message(), node_list(m, i / 4)));
     }

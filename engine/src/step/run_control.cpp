@@ -85,7 +85,8 @@ void RunControl::check_list_memory(const NodeStore& nodes, std::size_t real, std
 bool RunControl::finished(double time, std::size_t steps, const Totals& t, std::string& reason) const {
     const auto& s = scene_->stop;
     if (s.end_time > 0.0 && time >= s.end_time * (1.0 - 1e-12)) {
-        reason = fmt::format("end time {:.6g} s reached", s.end_time);
+        // In microseconds, as the progress line counts the time.
+        reason = fmt::format("end time {:.6g} us reached", s.end_time * 1e6);
         return true;
     }
     if (s.kinetic_energy_fraction > 0.0 && steps > 0 &&
