@@ -655,6 +655,17 @@ void write_summary(const fs::path& file, const Simulation& sim, const RunSummary
     field("element_steps_per_second", json_number(stepping > 0.0 ? sim.element_steps() / stepping : 0.0));
     field("snapshots", std::to_string(run.snapshots), true);
     j += "}\n";
+    // In plane strain the bodies are slices of unit thickness: the extensive quantities (masses,
+    // energies, momenta, forces, impulses, works) are per metre of it, and their keys say so, as
+    // history.csv's columns do.
+    if (scene.geometry == GeometryKind::PlaneStrain) {
+        for (const char* key : {"plastic_work_J", "initial_J", "kinetic_J", "internal_J", "viscous_work_J", "hourglass_work_J",
+                                "hourglass_energy_J", "boundary_work_J", "given_J", "reaction_N", "impulse_N_s", "friction_work_J",
+                                "work_J", "mass_kg", "kinetic_energy_J", "internal_energy_J", "momentum_kg_m_s", "main_piece_mass_kg"}) {
+            const std::string from = fmt::format("\"{}\":", key), to = fmt::format("\"{}_per_m\":", key);
+            for (std::size_t at = j.find(from); at != std::string::npos; at = j.find(from, at + to.size())) j.replace(at, from.size(), to);
+        }
+    }
     write_text_file(file, j);
 }
 

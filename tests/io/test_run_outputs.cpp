@@ -129,6 +129,26 @@ TEST(FolderLock, ASecondRunOnTheSameFolderIsRefusedAtOnce) {
 // footprint only where a rigid plane measures them, extensive quantities per metre of thickness in
 // plane strain, the energy error in per cent as the console prints it, a unit on every column of a
 // dimensional quantity.
+TEST(Summary, PlaneStrainKeysOfExtensiveQuantitiesArePerMetre) {
+    std::string slab = tiny_scene;
+    slab.replace(slab.find("axisymmetric"), 12, "plane-strain");
+    const fs::path dir = scratch("summary_per_metre");
+    for (const bool plane_strain : {false, true}) {
+        Simulation sim(parse_scene(plane_strain ? slab : tiny_scene, "s.toml"), 1);
+        sim.step();
+        write_summary(dir / "summary.json", sim, RunSummary{});
+        const std::string text = read_all(dir / "summary.json");
+        for (const char* key : {"mass_kg", "kinetic_energy_J", "plastic_work_J", "kinetic_J", "reaction_N", "momentum_kg_m_s"}) {
+            EXPECT_EQ(text.find(fmt::format("\"{}\":", key)) != std::string::npos, !plane_strain) << key << "\n" << text;
+            EXPECT_EQ(text.find(fmt::format("\"{}_per_m\":", key)) != std::string::npos, plane_strain) << key;
+        }
+        // Intensive quantities keep their units.
+        EXPECT_NE(text.find("\"time_s\":"), std::string::npos);
+        EXPECT_NE(text.find("\"length_m\":"), std::string::npos);
+    }
+    fs::remove_all(dir);
+}
+
 TEST(HistoryColumns, BelongToTheSceneAndCarryTheirUnits) {
     const auto header_and_row = [](const std::string& text) {
         const Scene scene = parse_scene(text, "columns.toml");
