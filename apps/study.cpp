@@ -345,11 +345,24 @@ int run_study(const StudyOptions& options) {
         for (const auto& c : report.cases) {
             if (c.finished && (!finest || c.cell_size < finest->cell_size)) finest = &c;
         }
-        auto ref = io::reference_from_study(report, analysis, series_names.front(), finest ? finest->outline : decltype(finest->outline){});
+        // A reference holds every metric the runs produced, whatever --metrics chose to show.
+        io::StudyReport whole = report;
+        whole.chosen_metrics.clear();
+        auto ref = io::reference_from_study(whole, io::analyse_study(whole), series_names.front(),
+                                            finest ? finest->outline : decltype(finest->outline){});
         ref.peak_radius = scene.output.peak_radius;
         io::write_element_reference(*options.reference, ref);
         fmt::print("element reference: {} ({} metrics{})\n", options.reference->string(), ref.values.size(),
                    ref.missing.empty() ? "" : fmt::format(", {} without a reference", ref.missing.size()));
+    }
+    // A metric asked for that no run produced (a crater without a target, a contact time of a
+    // body that never left its plane), or that is shown but not analysed: say so.
+    for (const auto& key : report.chosen_metrics) {
+        if (std::find(analysis.metrics.begin(), analysis.metrics.end(), key) == analysis.metrics.end()) {
+            fmt::print(stderr, "note: --metrics {}: no run produced it (docs/study.md says when each metric applies)\n", key);
+        } else if (!io::find_study_metric(key)->analysed) {
+            fmt::print(stderr, "note: --metrics {}: shown in the tables, not analysed (it is no converging quantity)\n", key);
+        }
     }
     if (!options.quiet) print_summary(report, analysis);
     std::string files = "study.md, study.csv";

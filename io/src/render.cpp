@@ -351,7 +351,10 @@ struct Disc {
     double value;
     bool has_value;
     bool failed = false;
-    int region = 0;  // 0 free; k + 1 held by the scene's prescribed velocity k
+    int region = 0;      // 0 free; k + 1 held by the scene's prescribed velocity k
+    bool image = false;  // the mirror image of a node (2D, mirrored)
+    std::size_t source = 0;  // the node's place among the discs before mirroring
+    bool counts = true;      // the one drawn disc of its node that the counts and the range take
 };
 
 struct Triangle {
@@ -360,6 +363,9 @@ struct Triangle {
     bool has_value;
     double depth;
     bool failed = false;  // its cell has failed
+    bool image = false;   // a mirror image
+    std::size_t source = 0;  // its place among the triangles before mirroring
+    bool counts = true;      // the one drawn copy of it that the counts and the range take
 };
 
 // The field on one part: its values per point or per cell, or nullopt when the part lacks it.
@@ -462,13 +468,17 @@ Rgb colour_of(double v, bool has_value, double lo, double hi) {
     return colour_map((v - lo) / (hi - lo));
 }
 
+// A pixel coordinate as an int, clamped far outside any picture: a window of a few nanometres
+// puts distant nodes at astronomical pixel coordinates, which an int cannot hold.
+int pixel_index(double v) { return std::isnan(v) ? -100000000 : static_cast<int>(std::clamp(v, -1e8, 1e8)); }
+
 void draw_disc(Image& img, const Area& plot, const PictureFrame& frame, const Disc& d, Rgb colour) {
     const auto [px, py] = frame.pixel(d.u, d.v);
     const double r = d.radius * frame.scale;
-    const int x0 = std::max(plot.x0, static_cast<int>(std::floor(px - r)));
-    const int x1 = std::min(plot.x1 - 1, static_cast<int>(std::ceil(px + r)));
-    const int y0 = std::max(plot.y0, static_cast<int>(std::floor(py - r)));
-    const int y1 = std::min(plot.y1 - 1, static_cast<int>(std::ceil(py + r)));
+    const int x0 = std::max(plot.x0, pixel_index(std::floor(px - r)));
+    const int x1 = std::min(plot.x1 - 1, pixel_index(std::ceil(px + r)));
+    const int y0 = std::max(plot.y0, pixel_index(std::floor(py - r)));
+    const int y1 = std::min(plot.y1 - 1, pixel_index(std::ceil(py + r)));
     bool any = false;
     for (int y = y0; y <= y1; ++y) {
         for (int x = x0; x <= x1; ++x) {
@@ -480,7 +490,7 @@ void draw_disc(Image& img, const Area& plot, const PictureFrame& frame, const Di
         }
     }
     // A disc smaller than a pixel still shows: the pixel holding its centre.
-    const int cx = static_cast<int>(std::floor(px)), cy = static_cast<int>(std::floor(py));
+    const int cx = pixel_index(std::floor(px)), cy = pixel_index(std::floor(py));
     if (!any && cx >= plot.x0 && cx < plot.x1 && cy >= plot.y0 && cy < plot.y1) img.set(cx, cy, colour);
 }
 
@@ -495,10 +505,10 @@ void draw_triangle(Image& img, const Area& plot, const PictureFrame& frame, cons
     if (area == 0.0 || !std::isfinite(area)) return;
     const double minx = std::min({p[0][0], p[1][0], p[2][0]}), maxx = std::max({p[0][0], p[1][0], p[2][0]});
     const double miny = std::min({p[0][1], p[1][1], p[2][1]}), maxy = std::max({p[0][1], p[1][1], p[2][1]});
-    const int x0 = std::max(plot.x0, static_cast<int>(std::floor(minx)));
-    const int x1 = std::min(plot.x1 - 1, static_cast<int>(std::ceil(maxx)));
-    const int y0 = std::max(plot.y0, static_cast<int>(std::floor(miny)));
-    const int y1 = std::min(plot.y1 - 1, static_cast<int>(std::ceil(maxy)));
+    const int x0 = std::max(plot.x0, pixel_index(std::floor(minx)));
+    const int x1 = std::min(plot.x1 - 1, pixel_index(std::ceil(maxx)));
+    const int y0 = std::max(plot.y0, pixel_index(std::floor(miny)));
+    const int y1 = std::min(plot.y1 - 1, pixel_index(std::ceil(maxy)));
     for (int y = y0; y <= y1; ++y) {
         for (int x = x0; x <= x1; ++x) {
             const double cx = x + 0.5, cy = y + 0.5;
@@ -511,6 +521,35 @@ void draw_triangle(Image& img, const Area& plot, const PictureFrame& frame, cons
             img.set(x, y, paint(v, t.has_value));
         }
     }
+}
+
+// The scene's rigid and symmetry planes the view sees edge-on, as lines of the picture plane:
+// u = c (vertical) or v = c (horizontal). 2D scenes store (x, z) as the first two coordinates, as
+// the snapshots do; a 2D plane normal to x is mirrored with the run.
+struct PlaneLine {
+    const PlaneSpec* plane;
+    bool vertical;
+    double at;             // u or v
+    double toward_bodies;  // +1: the bodies lie towards +u (+v)
+};
+
+std::vector<PlaneLine> plane_lines_of(const Scene* scene, bool three_d, ViewDirection view, bool mirror) {
+    std::vector<PlaneLine> lines;
+    if (!scene) return lines;
+    for (const PlaneSpec& plane : scene->planes) {
+        if (plane.axis < 0 || plane.axis > (three_d ? 2 : 1)) continue;
+        std::array<double, 3> normal{}, point{};
+        normal[static_cast<std::size_t>(plane.axis)] = 1.0;
+        point[static_cast<std::size_t>(plane.axis)] = plane.position;
+        const ViewPoint n = three_d ? project(normal, view) : ViewPoint{normal[0], normal[1], 0.0};
+        const ViewPoint at = three_d ? project(point, view) : ViewPoint{point[0], point[1], 0.0};
+        if (n.u == 0.0 && n.v == 0.0) continue;  // faces the viewer
+        const bool vertical_line = n.u != 0.0;
+        const double side = plane.side * (vertical_line ? n.u : n.v);
+        lines.push_back({&plane, vertical_line, vertical_line ? at.u : at.v, side});
+        if (mirror && vertical_line && at.u != 0.0) lines.push_back({&plane, true, -at.u, -side});
+    }
+    return lines;
 }
 
 }  // namespace
@@ -624,25 +663,46 @@ Picture render_snapshot(const LoadedSnapshot& snapshot, GeometryKind geometry, c
         throw InputError(fmt::format("snapshot {} ({}) has nothing to draw: no nodes or cells with finite positions",
                                      snapshot.index, snapshot.entry.files.front().string()));
     }
+    // Counts, the colour range and the legends take each node and cell once, whether drawn by
+    // itself, by its mirror image or both: the first of its copies still drawn.
+    const auto count_own = [&] {
+        const auto mark = [](auto& items) {
+            std::size_t sources = 0;
+            for (const auto& item : items) sources = std::max(sources, item.source + 1);
+            std::vector<char> seen(sources, 0);
+            std::size_t n = 0;
+            for (auto& item : items) {
+                item.counts = !seen[item.source];
+                seen[item.source] = 1;
+                n += item.counts;
+            }
+            return n;
+        };
+        picture.discs = mark(discs);
+        picture.triangles = mark(triangles);
+    };
+    for (std::size_t i = 0; i < discs.size(); ++i) discs[i].source = i;
+    for (std::size_t i = 0; i < triangles.size(); ++i) triangles[i].source = i;
     if (mirror) {
         const std::size_t n = discs.size();
         for (std::size_t i = 0; i < n; ++i) {
             Disc d = discs[i];
             d.u = -d.u;
+            d.image = true;
             discs.push_back(d);
         }
         const std::size_t m = triangles.size();
         for (std::size_t i = 0; i < m; ++i) {
             Triangle t = triangles[i];
             for (auto& c : t.corner) c.u = -c.u;
+            t.image = true;
             triangles.push_back(t);
         }
     }
-    picture.discs = mirror ? discs.size() / 2 : discs.size();
-    picture.triangles = mirror ? triangles.size() / 2 : triangles.size();
+    count_own();
     if (options.region) {
-        // Keep what reaches into the window (mirrored images included: they are then counted as
-        // drawn nodes of their own).
+        // Keep what reaches into the window (a node whose own disc lies outside it may still be
+        // drawn by its mirror image; it is then counted once, as a node drawn).
         // Plain copies, not a structured binding: lambdas below capture them (C++20 as clang 14 reads it
         // does not allow capturing structured bindings).
         const double left = (*options.region)[0], right = (*options.region)[1], bottom = (*options.region)[2],
@@ -675,8 +735,7 @@ Picture render_snapshot(const LoadedSnapshot& snapshot, GeometryKind geometry, c
                                          format_quantity(bottom, "m"), format_quantity(top, "m"), format_quantity(umin, "m"),
                                          format_quantity(umax, "m"), format_quantity(vmin, "m"), format_quantity(vmax, "m")));
         }
-        picture.discs = discs.size();
-        picture.triangles = triangles.size();
+        count_own();
     }
     if (three_d) {
         // Painter's order: the farthest first, the file's order among equals.
@@ -696,11 +755,12 @@ Picture render_snapshot(const LoadedSnapshot& snapshot, GeometryKind geometry, c
         lo = std::min(lo, v);
         hi = std::max(hi, v);
     };
-    // Over the nodes and cells once: mirrored images are the second half of each list (3D runs,
-    // which are sorted, are never mirrored).
-    const std::size_t own_discs = picture.discs, own_triangles = picture.triangles;
-    for (std::size_t i = 0; i < own_discs; ++i) count_value(discs[i].value, discs[i].has_value);
-    for (std::size_t i = 0; i < own_triangles; ++i) {
+    // Over the nodes and cells once (count_own).
+    for (const Disc& d : discs) {
+        if (d.counts) count_value(d.value, d.has_value);
+    }
+    for (std::size_t i = 0; i < triangles.size(); ++i) {
+        if (!triangles[i].counts) continue;
         for (double v : triangles[i].value) count_value(v, triangles[i].has_value);
     }
     if (!(lo <= hi)) lo = hi = 0.0;  // nothing finite
@@ -713,13 +773,13 @@ Picture render_snapshot(const LoadedSnapshot& snapshot, GeometryKind geometry, c
                                          format_quantity(rlo, unit), format_quantity(rhi, unit), choice.label,
                                          format_quantity(lo, unit), format_quantity(hi, unit)));
         }
-        for (std::size_t i = 0; i < own_discs; ++i) {
-            if (!discs[i].has_value || !std::isfinite(discs[i].value)) continue;
-            picture.below_range += discs[i].value < rlo;
-            picture.above_range += discs[i].value > rhi;
+        for (const Disc& d : discs) {
+            if (!d.counts || !d.has_value || !std::isfinite(d.value)) continue;
+            picture.below_range += d.value < rlo;
+            picture.above_range += d.value > rhi;
         }
-        for (std::size_t i = 0; i < own_triangles; ++i) {
-            if (!triangles[i].has_value) continue;
+        for (std::size_t i = 0; i < triangles.size(); ++i) {
+            if (!triangles[i].counts || !triangles[i].has_value) continue;
             const auto [low, high] = std::minmax({triangles[i].value[0], triangles[i].value[1], triangles[i].value[2]});
             picture.below_range += low < rlo;
             picture.above_range += high > rhi;
@@ -739,8 +799,8 @@ Picture render_snapshot(const LoadedSnapshot& snapshot, GeometryKind geometry, c
         const auto add = [&](double v, bool has) {
             if (has && std::isfinite(v)) categories.push_back(std::llround(v));
         };
-        for (std::size_t i = 0; i < own_discs; ++i) add(discs[i].value, discs[i].has_value);
-        for (std::size_t i = 0; i < own_triangles; ++i) add(triangles[i].value[0], triangles[i].has_value);
+        for (const Disc& d : discs) add(d.value, d.has_value && d.counts);
+        for (const Triangle& t : triangles) add(t.value[0], t.has_value && t.counts);
         std::sort(categories.begin(), categories.end());
         categories.erase(std::unique(categories.begin(), categories.end()), categories.end());
     }
@@ -757,8 +817,8 @@ Picture render_snapshot(const LoadedSnapshot& snapshot, GeometryKind geometry, c
         if (picture.categorical && has && std::isfinite(v)) return category_colour(std::llround(v));
         return colour_of(v, has, lo, hi);
     };
-    for (std::size_t i = 0; i < own_discs; ++i) picture.failed += discs[i].failed;
-    for (std::size_t i = 0; i < own_triangles; ++i) picture.failed += triangles[i].failed;
+    for (const Disc& d : discs) picture.failed += d.counts && d.failed;
+    for (const Triangle& t : triangles) picture.failed += t.counts && t.failed;
 
     // Layout: text at the top, the colour bar (or legend) on the right, coordinates along the left
     // and bottom edges of the drawing, notes at the bottom.
@@ -787,31 +847,7 @@ Picture render_snapshot(const LoadedSnapshot& snapshot, GeometryKind geometry, c
     const int top = margin + 2 * line + margin / 2 + line;  // title, field and time; the vertical axis' name
     const int bottom = margin / 2 + tick_len + 2 * s + line + line + margin / 2;  // ticks, their labels, notes
 
-    // The scene's rigid and symmetry planes the view sees edge-on, as lines of the picture plane:
-    // u = c (vertical) or v = c (horizontal). 2D scenes store (x, z) as the first two coordinates,
-    // as the snapshots do; a 2D plane normal to x is mirrored with the run.
-    struct PlaneLine {
-        const PlaneSpec* plane;
-        bool vertical;
-        double at;             // u or v
-        double toward_bodies;  // +1: the bodies lie towards +u (+v)
-    };
-    std::vector<PlaneLine> plane_lines;
-    if (options.scene) {
-        for (const PlaneSpec& plane : options.scene->planes) {
-            if (plane.axis < 0 || plane.axis > (three_d ? 2 : 1)) continue;
-            std::array<double, 3> normal{}, point{};
-            normal[static_cast<std::size_t>(plane.axis)] = 1.0;
-            point[static_cast<std::size_t>(plane.axis)] = plane.position;
-            const ViewPoint n = three_d ? project(normal, view) : ViewPoint{normal[0], normal[1], 0.0};
-            const ViewPoint at = three_d ? project(point, view) : ViewPoint{point[0], point[1], 0.0};
-            if (n.u == 0.0 && n.v == 0.0) continue;  // faces the viewer
-            const bool vertical_line = n.u != 0.0;
-            const double side = plane.side * (vertical_line ? n.u : n.v);
-            plane_lines.push_back({&plane, vertical_line, vertical_line ? at.u : at.v, side});
-            if (mirror && vertical_line && at.u != 0.0) plane_lines.push_back({&plane, true, -at.u, -side});
-        }
-    }
+    const std::vector<PlaneLine> plane_lines = plane_lines_of(options.scene, three_d, view, mirror);
 
     double umin = std::numeric_limits<double>::infinity(), umax = -umin, vmin = umin, vmax = -umin;
     const auto extend = [&](double u, double v, double r) {
@@ -878,7 +914,14 @@ Picture render_snapshot(const LoadedSnapshot& snapshot, GeometryKind geometry, c
                 break;
             }
         }
-        for (double t = std::ceil(a / step) * step; t <= b + 1e-9 * span; t += step) out.push_back(std::abs(t) < 1e-9 * span ? 0.0 : t);
+        // From an integer index, so that a step below the doubles' resolution at a (a window of
+        // nanometres far from the origin) cannot stall the loop: at most `most` + 1 ticks.
+        const double first = std::ceil(a / step);
+        for (int k = 0; k <= most; ++k) {
+            const double t = (first + k) * step;
+            if (t > b + 1e-9 * span) break;
+            if (out.empty() || t > out.back()) out.push_back(std::abs(t) < 1e-9 * span ? 0.0 : t);
+        }
         return out;
     };
     const auto coordinate_text = [&](double picture_coordinate, const Axis& axis) {
@@ -910,26 +953,25 @@ Picture render_snapshot(const LoadedSnapshot& snapshot, GeometryKind geometry, c
     picture.frame = frame;
 
     Image img(width, height, background_colour);
-    for (const auto& t : triangles) draw_triangle(img, plot, frame, t, paint);
-    for (const auto& d : discs) draw_disc(img, plot, frame, d, paint(d.value, d.has_value));
-    // Failure: a black dot at the centre of each failed node (a third of its radius, at least a
-    // pixel across) and of each failed triangle.
-    if (picture.failed > 0) {
-        for (const auto& d : discs) {
-            if (d.failed) draw_disc(img, plot, frame, {d.u, d.v, std::max(0.35 * d.radius, 0.75 / frame.scale), d.depth, 0.0, true}, text_colour);
-        }
-        for (const auto& t : triangles) {
-            if (!t.failed) continue;
-            const double u = (t.corner[0].u + t.corner[1].u + t.corner[2].u) / 3.0, v = (t.corner[0].v + t.corner[1].v + t.corner[2].v) / 3.0;
-            draw_disc(img, plot, frame, {u, v, 1.0 / frame.scale, t.depth, 0.0, true}, text_colour);
-        }
+    // Failure: a black dot at the centre of each failed node (of 0.35 times its radius, at least
+    // 0.75 pixel) and of each failed triangle (of a pixel), drawn with its node or triangle, so
+    // that in 3D what lies in front covers it too.
+    for (const auto& t : triangles) {
+        draw_triangle(img, plot, frame, t, paint);
+        if (!t.failed) continue;
+        const double u = (t.corner[0].u + t.corner[1].u + t.corner[2].u) / 3.0, v = (t.corner[0].v + t.corner[1].v + t.corner[2].v) / 3.0;
+        draw_disc(img, plot, frame, {u, v, 1.0 / frame.scale, t.depth, 0.0, true}, text_colour);
+    }
+    for (const auto& d : discs) {
+        draw_disc(img, plot, frame, d, paint(d.value, d.has_value));
+        if (d.failed) draw_disc(img, plot, frame, {d.u, d.v, std::max(0.35 * d.radius, 0.75 / frame.scale), d.depth, 0.0, true}, text_colour);
     }
 
     // The planes: a line across the drawing (rigid: solid, with short strokes on the side away
     // from the bodies; symmetry: dashed) and the plane's name beside it on the wall's side.
     for (const PlaneLine& l : plane_lines) {
         const auto [px, py] = frame.pixel(l.vertical ? l.at : 0.0, l.vertical ? 0.0 : l.at);
-        const int p = static_cast<int>(std::lround(l.vertical ? px : py));
+        const int p = pixel_index(std::round(l.vertical ? px : py));
         if (l.vertical ? (p < plot.x0 || p >= plot.x1) : (p < plot.y0 || p >= plot.y1)) continue;
         const int from = l.vertical ? plot.y0 : plot.x0, to = l.vertical ? plot.y1 : plot.x1;
         const bool dashed = l.plane->kind == PlaneKind::Symmetry;
@@ -985,8 +1027,11 @@ Picture render_snapshot(const LoadedSnapshot& snapshot, GeometryKind geometry, c
     for (const auto& [key, box] : held_boxes) {
         const auto [x0, y0] = frame.pixel(box[0], box[3]);
         const auto [x1, y1] = frame.pixel(box[1], box[2]);
-        const int l = static_cast<int>(std::floor(x0)) - 2 * s, r = static_cast<int>(std::ceil(x1)) + 2 * s;
-        const int t = static_cast<int>(std::floor(y0)) - 2 * s, b = static_cast<int>(std::ceil(y1)) + 2 * s;
+        // Clamped to just outside the drawing, so that the loops below stay within the picture.
+        const int l = std::clamp(pixel_index(std::floor(x0)) - 2 * s, plot.x0 - 1, plot.x1);
+        const int r = std::clamp(pixel_index(std::ceil(x1)) + 2 * s, plot.x0 - 1, plot.x1);
+        const int t = std::clamp(pixel_index(std::floor(y0)) - 2 * s, plot.y0 - 1, plot.y1);
+        const int b = std::clamp(pixel_index(std::ceil(y1)) + 2 * s, plot.y0 - 1, plot.y1);
         const auto dash = [&](int q, int from) { return ((q - from) / (4 * s)) % 2 == 0; };
         for (int x = l; x <= r; ++x) {
             if (!dash(x, l) || x < plot.x0 || x >= plot.x1) continue;
@@ -1031,14 +1076,14 @@ Picture render_snapshot(const LoadedSnapshot& snapshot, GeometryKind geometry, c
     const int most_u = std::max(2, static_cast<int>(plot_wd / std::max(1, detail::text_width("-00.00", s) + 6 * s)));
     const int most_v = std::max(2, static_cast<int>(plot_hd / (3 * line)));
     for (const double u : ticks_over(frame.u_left, frame.u_left + visible_w, std::min(most_u, 10))) {
-        const int x = static_cast<int>(std::lround(frame.pixel(u, 0.0)[0]));
+        const int x = pixel_index(std::round(frame.pixel(u, 0.0)[0]));
         fill_rect(img, x - s / 2, plot.y1, x - s / 2 + std::max(s, 1), plot.y1 + tick_len, text_colour);
         const std::string label = coordinate_text(u, horizontal);
         const int w = detail::text_width(label, s);
         draw_text(img, std::clamp(x - w / 2, 0, width - w), plot.y1 + tick_len + 2 * s, label, s, text_colour);
     }
     for (const double v : ticks_over(frame.v_top - visible_h, frame.v_top, std::min(most_v, 10))) {
-        const int y = static_cast<int>(std::lround(frame.pixel(0.0, v)[1]));
+        const int y = pixel_index(std::round(frame.pixel(0.0, v)[1]));
         fill_rect(img, plot.x0 - tick_len, y - s / 2, plot.x0, y - s / 2 + std::max(s, 1), text_colour);
         const std::string label = coordinate_text(v, vertical);
         draw_text(img, plot.x0 - tick_len - 2 * s - detail::text_width(label, s), y - text_h / 2 + s, label, s, text_colour);
@@ -1139,9 +1184,20 @@ std::array<double, 4> series_extent(const SnapshotIndex& series, GeometryKind ge
             // estimated from the part), an element corner as a point.
             const double spacing = part.type() == "PolyData" && diameter.empty() ? estimated_spacing(points, three_d, raw) : 0.0;
             for (std::size_t i = 0; i < points.size(); ++i) {
-                const double d = diameter.empty() ? spacing : diameter[i] > 0.0 ? diameter[i] : spacing;
+                const double d = diameter.empty() || !(diameter[i] > 0.0) || !std::isfinite(diameter[i]) ? spacing : diameter[i];
                 extend(points[i], 0.5 * d);
             }
+        }
+    }
+    // The planes the drawing reaches to (render_snapshot does the same for one snapshot).
+    for (const PlaneLine& l : plane_lines_of(options.scene, three_d, view, mirror)) {
+        if (!(umin < umax) || !(vmin < vmax)) break;  // nothing drawn: the error below
+        if (l.vertical) {
+            umin = std::min(umin, l.at);
+            umax = std::max(umax, l.at);
+        } else {
+            vmin = std::min(vmin, l.at);
+            vmax = std::max(vmax, l.at);
         }
     }
     if (!(umin < umax) || !(vmin < vmax)) {

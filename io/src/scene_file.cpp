@@ -616,7 +616,11 @@ OutputOptions read_output(const Reporter& reporter, const toml::table& table) {
             for (const SnapshotField n : named) {
                 const auto& chosen = o.snapshot_format.fields;
                 if (std::find(chosen.begin(), chosen.end(), n) != chosen.end()) {
-                    r.fail_at("fields", fmt::format("\"{}\" is named twice", name_of(n)));
+                    const bool with_all = named.size() > 1 || std::any_of(list->begin(), list->begin() + static_cast<std::ptrdiff_t>(k), [](const toml::node& w) {
+                        const auto* text = w.as_string();
+                        return text && text->get() == "all";
+                    });
+                    r.fail_at("fields", fmt::format("\"{}\" is named twice{}", name_of(n), with_all ? " (\"all\" names every field)" : ""));
                 }
                 o.snapshot_format.fields.push_back(n);
             }

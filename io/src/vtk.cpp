@@ -42,30 +42,11 @@ std::function<double(std::size_t, int)> vector_field(const NodeStore& nodes, con
     return [&f, dim](std::size_t i, int c) { return c < dim ? f[c][i] : 0.0; };
 }
 
-// The Cauchy stress s - P I of node i as a VTK symmetric tensor, components XX, YY, ZZ, XY, YZ, XZ
-// (the order ParaView reads a 6-component array in). 2D nodes are drawn in the X-Y plane as
-// (x, z), so X = x, Y = z and Z is the out-of-plane direction (hoop in axisymmetric geometry);
-// the stored order is that of geometry.hpp.
+// The Cauchy stress of node i as a VTK symmetric tensor (detail::vtk_stress_component).
 double vtk_stress(const NodeStore& nodes, std::size_t i, int c) {
-    const auto& s = nodes.deviatoric_stress;
-    const double p = nodes.pressure[i];
-    if (nodes.dim() == 2) {
-        switch (c) {
-            case 0: return s[0][i] - p;  // xx
-            case 1: return s[1][i] - p;  // zz
-            case 2: return s[3][i] - p;  // out of plane
-            case 3: return s[2][i];      // xz
-            default: return 0.0;         // the out-of-plane shears vanish
-        }
-    }
-    switch (c) {
-        case 0: return s[0][i] - p;  // xx
-        case 1: return s[1][i] - p;  // yy
-        case 2: return s[2][i] - p;  // zz
-        case 3: return s[5][i];      // xy
-        case 4: return s[3][i];      // yz
-        default: return s[4][i];     // xz
-    }
+    std::array<double, 6> s{};
+    for (int k = 0; k < stress_components(nodes.dim()); ++k) s[static_cast<std::size_t>(k)] = nodes.deviatoric_stress[k][i];
+    return detail::vtk_stress_component(s.data(), nodes.pressure[i], nodes.dim(), c);
 }
 
 }  // namespace

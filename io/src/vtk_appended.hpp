@@ -12,6 +12,30 @@
 
 namespace gpa::io::detail {
 
+// Component c of the Cauchy stress s - P I as VTK's symmetric tensor, in the order ParaView reads
+// six components: XX, YY, ZZ, XY, YZ, XZ. 2D snapshots draw (x, z) as VTK's (X, Y), so X = x,
+// Y = z and Z is the out-of-plane direction (hoop in axisymmetric geometry); `s` holds the stored
+// deviator in the order of geometry.hpp (2D: xx, zz, xz, out of plane; 3D: xx, yy, zz, yz, xz, xy).
+inline double vtk_stress_component(const double* s, double pressure, int dim, int c) {
+    if (dim == 2) {
+        switch (c) {
+            case 0: return s[0] - pressure;  // xx
+            case 1: return s[1] - pressure;  // zz
+            case 2: return s[3] - pressure;  // out of plane
+            case 3: return s[2];             // xz
+            default: return 0.0;             // the out-of-plane shears vanish
+        }
+    }
+    switch (c) {
+        case 0: return s[0] - pressure;  // xx
+        case 1: return s[1] - pressure;  // yy
+        case 2: return s[2] - pressure;  // zz
+        case 3: return s[5];             // xy
+        case 4: return s[3];             // yz
+        default: return s[4];            // xz
+    }
+}
+
 class AppendedBlocks {
 public:
     // A Float64 array of `components` values for each of `count` entries, or Float32 (each value

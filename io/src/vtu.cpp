@@ -58,16 +58,11 @@ void write_vtu(const std::filesystem::path& path, const ElementMesh& mesh, const
                 });
                 break;
             case SnapshotField::Stress:
-                // As the particles' (vtk.cpp): XX, YY, ZZ, XY, YZ, XZ with X = x, Y = z, Z out of plane.
+                // As the particles' (detail::vtk_stress_component).
                 cell_floats(f, 6, [&](std::size_t i, int c) {
-                    const auto& s = p.deviatoric_stress;
-                    switch (c) {
-                        case 0: return s[0][i] - p.pressure[i];
-                        case 1: return s[1][i] - p.pressure[i];
-                        case 2: return s[3][i] - p.pressure[i];
-                        case 3: return s[2][i];
-                        default: return 0.0;
-                    }
+                    const std::array<double, 4> dev{p.deviatoric_stress[0][i], p.deviatoric_stress[1][i], p.deviatoric_stress[2][i],
+                                                    p.deviatoric_stress[3][i]};
+                    return detail::vtk_stress_component(dev.data(), p.pressure[i], 2, c);
                 });
                 break;
             case SnapshotField::PlasticStrain: cell_scalar(f, p.plastic_strain); break;

@@ -466,6 +466,60 @@ TEST(Render, FailedNodesCarryABlackDotUnlessAskedNot) {
     EXPECT_EQ(pixel_at(by_field, 3e-3, 1e-3), colour_map(1.0));
 }
 
+TEST(Render, AFailedNodeBehindAnotherIsCoveredAndMirrorImagesAreNotCounted) {
+    // 3D, seen along +y: the failed node at y = 0 lies behind the intact one at y = -1 mm (nearer
+    // the viewer) at the same x and z, so the nearer disc hides it and its dot.
+    NodeStore solid(GeometryKind::ThreeD, 3);
+    solid.position[0] = {1e-3, 1e-3, 3e-3};
+    solid.position[1] = {0.0, -1e-3, 0.0};
+    solid.position[2] = {1e-3, 1e-3, 1e-3};
+    solid.diameter = {0.5e-3, 0.5e-3, 0.5e-3};
+    solid.pressure = {1.0, 2.0, 3.0};
+    solid.failed = {1, 0, 0};
+    const LoadedSnapshot s3 = snapshot_of("failed_behind", solid);
+    RenderOptions o;
+    o.field = "pressure";
+    const Picture p = render_snapshot(s3, GeometryKind::ThreeD, o);
+    EXPECT_EQ(p.failed, 1u);
+    EXPECT_EQ(pixel_at(p, 1e-3, 1e-3), colour_map(0.5));  // the nearer node's colour, no dot
+    // A mirrored 2D run: counts take each node once, with or without a region (which draws the
+    // mirror images in it too).
+    NodeStore n = three_nodes();
+    n.failed[1] = 1;
+    const LoadedSnapshot s2 = snapshot_of("failed_mirrored", n);
+    RenderOptions m;
+    m.field = "pressure";
+    const Picture whole = render_snapshot(s2, GeometryKind::Axisymmetric, m);
+    EXPECT_EQ(whole.discs, 3u);
+    EXPECT_EQ(whole.failed, 1u);
+    m.region = std::array<double, 4>{-4e-3, 4e-3, 0.0, 4e-3};
+    const Picture framed = render_snapshot(s2, GeometryKind::Axisymmetric, m);
+    EXPECT_EQ(framed.discs, 3u);
+    EXPECT_EQ(framed.failed, 1u);
+    // Only the mirror images in the window: each node is still counted once.
+    m.region = std::array<double, 4>{-4e-3, -0.5e-3, 0.0, 4e-3};
+    const Picture images = render_snapshot(s2, GeometryKind::Axisymmetric, m);
+    EXPECT_EQ(images.discs, 3u);
+    EXPECT_EQ(images.failed, 1u);
+}
+
+TEST(Render, AWindowOfNanometresFarFromTheOriginDrawsAndEnds) {
+    // The doubles' spacing at 1 m is 2.2e-16 m: a window of a few of them once stalled the tick
+    // loop and put the nodes at pixel coordinates beyond an int.
+    NodeStore n(GeometryKind::PlaneStrain, 1);
+    n.position[0] = {1.0};
+    n.position[1] = {1.0};
+    n.diameter = {1e-3};
+    n.pressure = {1.0};
+    const LoadedSnapshot s = snapshot_of("tiny_window", n);
+    RenderOptions o;
+    o.field = "pressure";
+    o.region = std::array<double, 4>{1.0, std::nextafter(std::nextafter(1.0, 2.0), 2.0), 1.0, std::nextafter(std::nextafter(1.0, 2.0), 2.0)};
+    const Picture p = render_snapshot(s, GeometryKind::PlaneStrain, o);
+    EXPECT_EQ(p.discs, 1u);
+    EXPECT_EQ(p.image.at(p.image.width / 3, p.image.height / 2), colour_map(0.5));  // inside the one disc
+}
+
 TEST(Render, BodiesAndMaterialsAreCategoriesNamedByTheScene) {
     NodeStore n = three_nodes();
     n.body = {0, 2, 1};

@@ -369,7 +369,7 @@ TEST(SnapshotFiles, EveryFieldHoldsItsNodeValuesInBothPrecisions) {
     std::string description;
     Snapshot flat = run_briefly(bar_2d);
     Snapshot solid = run_briefly(bar_3d);
-    const Snapshot elements = run_briefly(element_bar);
+    Snapshot elements = run_briefly(element_bar);
     // Make every value of the flags and the clamp occur: a failed node with damage past 1, a
     // fixed one, and a second body index.
     for (Snapshot* s : {&flat, &solid}) {
@@ -383,7 +383,18 @@ TEST(SnapshotFiles, EveryFieldHoldsItsNodeValuesInBothPrecisions) {
         n.velocity_region[3] = 1;
         EXPECT_GT(*std::max_element(n.plastic_strain.begin(), n.plastic_strain.end()), 0.0);
     }
+    // Every stress component distinct and non-zero at node 0, so that two swapped components
+    // cannot pass (the stored order is not the written one).
+    for (Snapshot* snap : {&flat, &solid}) {
+        NodeStore& n = snap->particles;
+        for (int c = 0; c < stress_components(n.dim()); ++c) n.deviatoric_stress[c][0] = (c + 1) * 1.25e6;
+        n.pressure[0] = 0.5e6;
+    }
     ASSERT_TRUE(elements.elements.has_value());
+    // A failed element cell with damage past 1, and distinct stress components there too.
+    elements.elements->points.failed[5] = 1;
+    elements.elements->points.damage[5] = 1.3;
+    for (int c = 0; c < 4; ++c) elements.elements->points.deviatoric_stress[c][0] = (c + 1) * 1.25e6;
     EXPECT_GT(*std::max_element(elements.elements->points.plastic_strain.begin(), elements.elements->points.plastic_strain.end()), 0.0);
     for (const bool float32 : {false, true}) {
         const std::string width = float32 ? "float32" : "float64";

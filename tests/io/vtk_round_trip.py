@@ -10,7 +10,11 @@ Usage: vtk_round_trip.py FOLDER   (prints one line per file; exit 1 on any diffe
 import struct
 import sys
 
-import vtk
+try:
+    import vtk
+except ImportError:
+    print("vtk_round_trip.py: Python's vtk module is not installed (Debian: python3-vtk9; scripts/install-deps.sh installs it)")
+    sys.exit(1)
 
 # The VTK data type each XML type name must be read as (vtkType.h). Int64 is read as long long
 # or, where long is 64 bits wide, as long or vtkIdType; all of them hold the ids exactly.
