@@ -552,6 +552,16 @@ std::vector<PlaneLine> plane_lines_of(const Scene* scene, bool three_d, ViewDire
     return lines;
 }
 
+// Widens a drawing's extent {umin, umax} x {vmin, vmax} to hold the plane lines.
+void reach_to_planes(const std::vector<PlaneLine>& lines, double& umin, double& umax, double& vmin, double& vmax) {
+    for (const PlaneLine& l : lines) {
+        double& low = l.vertical ? umin : vmin;
+        double& high = l.vertical ? umax : vmax;
+        low = std::min(low, l.at);
+        high = std::max(high, l.at);
+    }
+}
+
 }  // namespace
 
 Picture render_snapshot(const LoadedSnapshot& snapshot, GeometryKind geometry, const RenderOptions& options) {
@@ -865,15 +875,7 @@ Picture render_snapshot(const LoadedSnapshot& snapshot, GeometryKind geometry, c
             for (const auto& c : t.corner) extend(c.u, c.v, 0.0);
         }
         // The drawing reaches to the planes, so that a gap between a body and its wall shows.
-        for (const PlaneLine& l : plane_lines) {
-            if (l.vertical) {
-                umin = std::min(umin, l.at);
-                umax = std::max(umax, l.at);
-            } else {
-                vmin = std::min(vmin, l.at);
-                vmax = std::max(vmax, l.at);
-            }
-        }
+        reach_to_planes(plane_lines, umin, umax, vmin, vmax);
     }
     double world_w = umax - umin, world_h = vmax - vmin;
     const double world_size = std::max(world_w, world_h) > 0.0 ? std::max(world_w, world_h) : 1e-3;
@@ -1189,17 +1191,8 @@ std::array<double, 4> series_extent(const SnapshotIndex& series, GeometryKind ge
             }
         }
     }
-    // The planes the drawing reaches to (render_snapshot does the same for one snapshot).
-    for (const PlaneLine& l : plane_lines_of(options.scene, three_d, view, mirror)) {
-        if (!(umin < umax) || !(vmin < vmax)) break;  // nothing drawn: the error below
-        if (l.vertical) {
-            umin = std::min(umin, l.at);
-            umax = std::max(umax, l.at);
-        } else {
-            vmin = std::min(vmin, l.at);
-            vmax = std::max(vmax, l.at);
-        }
-    }
+    // The planes the drawing reaches to, as render_snapshot's (nothing drawn: the error below).
+    if (umin < umax && vmin < vmax) reach_to_planes(plane_lines_of(options.scene, three_d, view, mirror), umin, umax, vmin, vmax);
     if (!(umin < umax) || !(vmin < vmax)) {
         throw SnapshotError(fmt::format("{}: no snapshot has a point with a finite position to frame", series.pvd.string()));
     }

@@ -647,6 +647,16 @@ TEST(Render, OneFrameHoldsEverySnapshotOfARun) {
     EXPECT_NEAR(e[3], 5.1e-3, 1e-15);
     o.mirror = false;
     EXPECT_NEAR(series_extent(index, GeometryKind::Axisymmetric, o)[0], 0.9e-3, 1e-15);
+    // The frame reaches to the scene's planes, as a picture does: an anvil 1 mm below the axis' origin.
+    Scene scene;
+    PlaneSpec anvil;
+    anvil.name = "anvil";
+    anvil.axis = 1;
+    anvil.position = -1e-3;
+    scene.planes.push_back(anvil);
+    o.scene = &scene;
+    EXPECT_EQ(series_extent(index, GeometryKind::Axisymmetric, o)[2], -1e-3);
+    o.scene = nullptr;
     // Passed as the region, the first snapshot is drawn in the frame of the whole run: its
     // node sits in the lower left of a picture as tall as the run's path.
     o.region = e;
