@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include "gpa/engine/ghosts.hpp"
 #include "gpa/engine/neighbours.hpp"
 #include "support/lattices.hpp"
 
@@ -86,6 +87,96 @@ TEST(Search, FixedCentresKeepLatticeNeighboursAndFindOtherBodies) {
     // A fixed node of body 0 at the interface with body 1 gains body-1 neighbours by search.
     const std::size_t top_row = 14 * 15 + 7;
     EXPECT_GT(fast.row_size(top_row), n.fixed_neighbours.row_size(top_row));
+}
+
+// A cloud whose every 50th node has grown 10 to 30 times (debris of a fractured body): such
+// nodes sit in a grid of their own, and every pair is still found, from both ends.
+void make_outsized(NodeStore& n, std::uint64_t seed) {
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<double> growth(10.0, 30.0);
+    for (std::size_t i = 0; i < n.size(); i += 50) n.diameter[i] *= growth(rng);
+}
+
+TEST(Search, OutsizedNodesHaveAGridOfTheirOwnAndEveryPairIsFound) {
+    for (const GeometryKind g : {GeometryKind::PlaneStrain, GeometryKind::ThreeD}) {
+        for (double a : {0.8, 1.0, 1.5}) {
+            auto n = random_cloud(g, 2500, 4);
+            if (g == GeometryKind::ThreeD) {
+                for (auto& d : n.diameter) d *= 2.5;
+            }
+            make_outsized(n, 5);
+            const DiameterSpread spread = diameter_spread(n, n.size());
+            ASSERT_TRUE(spread.any_outsized());
+            EXPECT_LT(spread.bulk, spread.cut);
+            EXPECT_LT(spread.cut, spread.largest);
+            NeighbourScratch scratch;
+            CompressedRows fast;
+            find_neighbours(n, a, n.size(), fast, scratch);
+            EXPECT_EQ(scratch.outsized.size(), 50u) << "every 50th node, and no other";
+            expect_same_sets(fast, find_neighbours_brute_force(n, a, n.size()));
+        }
+    }
+}
+
+TEST(Search, WithoutOutsizedNodesTheBulkIsEveryNode) {
+    auto n = random_cloud(GeometryKind::PlaneStrain, 1000, 6);  // diameters within a factor of 5: none above twice the mean
+    const DiameterSpread spread = diameter_spread(n, n.size());
+    EXPECT_FALSE(spread.any_outsized());
+    EXPECT_EQ(spread.bulk, spread.largest);
+    EXPECT_EQ(bulk_interaction_radius(n, 1.3, n.size()), largest_interaction_radius(n, 1.3, n.size()));
+}
+
+// Ghosts given to the nodes within reach of the pairs (GhostSet::pair_reach) make the same pairs
+// as ghosts given to every node within the largest interaction radius, with outsized nodes
+// about, and far fewer ghosts.
+TEST(Search, GhostsWithinThePairsReachGiveEveryPairOfGhostsWithinTheLargestReach) {
+    for (double a : {1.0, 1.5}) {
+        NodeStore base = random_cloud(GeometryKind::Axisymmetric, 2500, 7);
+        // Debris away from the planes grown 4 to 8 times, as in an impact's ejecta, and one
+        // outsized node close to the axis, whose reach crosses it.
+        std::mt19937_64 rng(8);
+        std::uniform_real_distribution<double> growth(4.0, 8.0);
+        for (std::size_t i = 0; i < base.size(); i += 20) {
+            if (std::min(base.position[0][i], base.position[1][i]) > 0.45) base.diameter[i] *= growth(rng);
+        }
+        base.diameter[100] = 0.2;
+        base.position[0][100] = 0.05;
+        ASSERT_TRUE(diameter_spread(base, base.size()).any_outsized());
+        const std::size_t real = base.size();
+        GhostSet set({{"axis", 0, 0.0, +1, false, false}, {"floor", 1, 0.0, +1, false, false}});
+        const auto pairs_with = [&](GhostReach reach, std::size_t& ghosts) {
+            NodeStore n = base;
+            GhostSet g = set;
+            g.update_contacts(n, real, true);
+            g.build(n, real, reach);
+            ghosts = g.count();
+            NeighbourScratch scratch;
+            CompressedRows lists;
+            find_neighbours(n, a, real, lists, scratch);
+            // Each entry as (source, planes): the two sets number their ghosts differently.
+            std::vector<std::vector<std::uint64_t>> keys(real);
+            for (std::size_t i = 0; i < real; ++i) {
+                for (NodeIndex j : lists.row(i)) {
+                    keys[i].push_back(j < real ? j : (std::uint64_t{g.planes_of(j - real)} << 40) | g.source(j - real));
+                }
+                std::sort(keys[i].begin(), keys[i].end());
+            }
+            return keys;
+        };
+        std::size_t wide_ghosts = 0, reach_ghosts = 0;
+        const auto wide = pairs_with(GhostReach{largest_interaction_radius(base, a, real), 0.0}, wide_ghosts);
+        NodeStore probe = base;
+        const auto reach = set.pair_reach(probe, real, a, 0.0);
+        EXPECT_EQ(reach.per_diameter, a);
+        const auto tight = pairs_with(reach, reach_ghosts);
+        std::size_t ghost_pairs = 0;
+        for (std::size_t i = 0; i < real; ++i) {
+            ASSERT_EQ(tight[i], wide[i]) << "centre " << i << ", a = " << a;
+            for (auto k : tight[i]) ghost_pairs += k >= (std::uint64_t{1} << 40);
+        }
+        EXPECT_GT(ghost_pairs, 100u) << "the planes must be in reach of many pairs";
+        EXPECT_LT(reach_ghosts * 2, wide_ghosts) << "a = " << a;
+    }
 }
 
 TEST(Search, ResultDoesNotDependOnThreadCountOrScratchReuse) {

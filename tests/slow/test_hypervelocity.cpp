@@ -10,6 +10,7 @@
 
 #include <gtest/gtest.h>
 
+#include "gpa/engine/neighbours.hpp"
 #include "gpa/engine/simulation.hpp"
 #include "gpa/io/scene_file.hpp"
 #include "support/scenes.hpp"
@@ -124,6 +125,39 @@ TEST(HypervelocitySpall, FragmentsOfTheAllVariableRunAtFineResolutionGainNoKinet
     EXPECT_LE(largest, e0 * (1.0 + 1e-9)) << "kinetic energy above the energy the run was given";
     EXPECT_LT(std::abs(sim.totals().energy_error), 1e-9);
     EXPECT_GT(sim.totals().failed_nodes, 0u) << "the projectile must have broken up";
+}
+
+// Debris of the broken projectile grows to many times the diameter of the nodes around it (its
+// volume keeps growing as its neighbours fly apart). The search gives such nodes a grid of their
+// own and the ghosts follow the pairs' reach (neighbours.hpp, DiameterSpread; ghosts.hpp,
+// GhostSet::pair_reach): every step's lists are checked against a full search whose ghosts cover
+// the largest interaction radius, and the axis must not give a ghost to every node within reach
+// of the largest debris node.
+TEST(HypervelocitySpall, ListsWithOutsizedDebrisEqualAFullSearchEveryStep) {
+    Scene s = hypervelocity(coarse_spacing, 4e-6);
+    s.solver.check_neighbour_lists = true;
+    Simulation sim(s, 2);
+    bool outsized = false;
+    std::size_t largest_reach_nodes = 0, ghosts_then = 0;
+    while (!sim.finished()) {
+        ASSERT_NO_THROW(sim.step()) << "step " << sim.steps();
+        const NodeStore& n = sim.nodes();
+        const std::size_t real = sim.real_count();
+        if (!diameter_spread(n, real).any_outsized()) continue;
+        outsized = true;
+        // Real nodes within 2 a d_max of the axis: the ghosts the axis would have had.
+        const double range = largest_interaction_radius(n, s.solver.influence_distance, real);
+        std::size_t within = 0;
+        for (std::size_t i = 0; i < real; ++i) within += n.position[0][i] < range;
+        if (within > largest_reach_nodes) {
+            largest_reach_nodes = within;
+            ghosts_then = sim.totals().ghost_nodes;
+        }
+    }
+    std::printf("[ measured ] %zu steps, %zu searches; at the widest reach %zu ghosts where 2 a d_max would give %zu\n",
+                sim.steps(), sim.totals().neighbour_searches, ghosts_then, largest_reach_nodes);
+    EXPECT_TRUE(outsized) << "the run must grow outsized debris to test anything";
+    EXPECT_LT(ghosts_then * 2, largest_reach_nodes);
 }
 
 TEST(HypervelocitySpall, ARunWithFailureAndSwitchingIsBitIdenticalOnOneAndTwoThreads) {

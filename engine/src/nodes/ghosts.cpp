@@ -107,7 +107,7 @@ std::size_t GhostSet::mask_slot(std::uint8_t mask) const {
     return static_cast<std::size_t>(it - masks_.begin());
 }
 
-void GhostSet::build(NodeStore& nodes, std::size_t real_count, double range, bool keep_between_searches) {
+void GhostSet::build(NodeStore& nodes, std::size_t real_count, GhostReach reach, bool keep_between_searches) {
     keep_between_searches_ = keep_between_searches;
     source_.clear();
     mask_.clear();
@@ -126,6 +126,7 @@ void GhostSet::build(NodeStore& nodes, std::size_t real_count, double range, boo
         tbb::parallel_for(tbb::blocked_range<std::size_t>(0, real_count, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
             for (std::size_t i = r.begin(); i != r.end(); ++i) {
                 bool near = selectable(nodes, i, m);
+                const double range = reach.of(nodes.diameter[i]);
                 for (std::size_t p = 0; p < planes_.size() && near; ++p) {
                     if ((m >> p) & 1u) near = planes_[p].distance(nodes.position[planes_[p].axis][i]) < range;
                 }
@@ -211,7 +212,23 @@ void GhostSet::mirror_vector_field(const std::array<double*, 3>& field, int dim,
     });
 }
 
-bool GhostSet::covers(const NodeStore& nodes, std::size_t real_count, double range) const {
+GhostReach GhostSet::pair_reach(const NodeStore& nodes, std::size_t real_count, double influence_distance, double margin) const {
+    const double a = influence_distance;
+    const double deepest = tbb::parallel_reduce(
+        tbb::blocked_range<std::size_t>(0, real_count, 4096), -std::numeric_limits<double>::infinity(),
+        [&](const tbb::blocked_range<std::size_t>& r, double acc) {
+            for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                for (const GhostPlane& p : planes_) acc = std::max(acc, a * nodes.diameter[i] - p.distance(nodes.position[p.axis][i]));
+            }
+            return acc;
+        },
+        [](double x, double y) { return std::max(x, y); });
+    // A non-finite diameter or position: every node near a plane gets its ghosts (the phases report it).
+    if (!std::isfinite(deepest)) return GhostReach{std::numeric_limits<double>::infinity(), 0.0};
+    return GhostReach{deepest + margin, a};
+}
+
+bool GhostSet::covers(const NodeStore& nodes, std::size_t real_count, GhostReach reach) const {
     if (planes_.empty()) return true;
     for (std::size_t slot = 0; slot < masks_.size(); ++slot) {
         const std::uint8_t m = masks_[slot];
@@ -223,6 +240,7 @@ bool GhostSet::covers(const NodeStore& nodes, std::size_t real_count, double ran
                 for (std::size_t i = r.begin(); i != r.end() && !found; ++i) {
                     if (index[i] >= 0 || !selectable(nodes, i, m)) continue;
                     bool near = true;
+                    const double range = reach.of(nodes.diameter[i]);
                     for (std::size_t p = 0; p < planes_.size() && near; ++p) {
                         if ((m >> p) & 1u) near = planes_[p].distance(nodes.position[planes_[p].axis][i]) < range;
                     }

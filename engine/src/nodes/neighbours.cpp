@@ -48,46 +48,85 @@ double largest_interaction_radius(const NodeStore& nodes, double a, std::size_t 
     return 2.0 * a * d_max;
 }
 
-void CellGrid::build(const NodeStore& store, std::size_t count, double min_cell_size) {
-    dim = store.dim();
+namespace {
+
+// Puts the `count` nodes member(0), ..., member(count - 1) (increasing indices) into the grid.
+template <class Member>
+void build_grid(CellGrid& grid, const NodeStore& store, std::size_t count, Member member, double min_cell_size) {
+    grid.dim = store.dim();
     std::array<double, 3> hi{0, 0, 0};
-    origin = {0, 0, 0};
-    for (int c = 0; c < dim; ++c) {
-        origin[c] = std::numeric_limits<double>::infinity();
+    grid.origin = {0, 0, 0};
+    for (int c = 0; c < grid.dim; ++c) {
+        grid.origin[c] = std::numeric_limits<double>::infinity();
         hi[c] = -std::numeric_limits<double>::infinity();
-        for (std::size_t i = 0; i < count; ++i) {
-            origin[c] = std::min(origin[c], store.position[c][i]);
-            hi[c] = std::max(hi[c], store.position[c][i]);
+        for (std::size_t k = 0; k < count; ++k) {
+            grid.origin[c] = std::min(grid.origin[c], store.position[c][member(k)]);
+            hi[c] = std::max(hi[c], store.position[c][member(k)]);
         }
-        if (count == 0) origin[c] = hi[c] = 0.0;
-        if (!std::isfinite(origin[c]) || !std::isfinite(hi[c])) {
+        if (count == 0) grid.origin[c] = hi[c] = 0.0;
+        if (!std::isfinite(grid.origin[c]) || !std::isfinite(hi[c])) {
             throw InputError(fmt::format("neighbour search: a node has a non-finite coordinate {}", c));
         }
     }
-    cell_size = min_cell_size > 0.0 ? min_cell_size : 1.0;
+    grid.cell_size = min_cell_size > 0.0 ? min_cell_size : 1.0;
     // Bound the grid by the node count: far-apart bodies must not make an enormous empty grid.
     for (;;) {
         double total = 1.0;
-        cells = {1, 1, 1};
-        for (int c = 0; c < dim; ++c) {
-            const double n = std::floor((hi[c] - origin[c]) / cell_size) + 1.0;
-            cells[c] = static_cast<std::size_t>(std::min(n, 1e12));
+        grid.cells = {1, 1, 1};
+        for (int c = 0; c < grid.dim; ++c) {
+            const double n = std::floor((hi[c] - grid.origin[c]) / grid.cell_size) + 1.0;
+            grid.cells[c] = static_cast<std::size_t>(std::min(n, 1e12));
             total *= n;
         }
         if (total <= 2.0 * static_cast<double>(count) + 64.0) break;
-        cell_size *= 1.25;
+        grid.cell_size *= 1.25;
     }
-    const std::size_t total = cells[0] * cells[1] * cells[2];
-    cell_start.assign(total + 1, 0);
+    const std::size_t total = grid.cells[0] * grid.cells[1] * grid.cells[2];
+    grid.cell_start.assign(total + 1, 0);
     std::vector<std::size_t> key(count);
-    for (std::size_t i = 0; i < count; ++i) {
-        key[i] = linear(cell_of(store, i));
-        ++cell_start[key[i] + 1];
+    for (std::size_t k = 0; k < count; ++k) {
+        key[k] = grid.linear(grid.cell_of(store, member(k)));
+        ++grid.cell_start[key[k] + 1];
     }
-    std::partial_sum(cell_start.begin(), cell_start.end(), cell_start.begin());
-    nodes.resize(count);
-    std::vector<std::size_t> next(cell_start.begin(), cell_start.end() - 1);
-    for (std::size_t i = 0; i < count; ++i) nodes[next[key[i]]++] = static_cast<NodeIndex>(i);
+    std::partial_sum(grid.cell_start.begin(), grid.cell_start.end(), grid.cell_start.begin());
+    grid.nodes.resize(count);
+    std::vector<std::size_t> next(grid.cell_start.begin(), grid.cell_start.end() - 1);
+    for (std::size_t k = 0; k < count; ++k) grid.nodes[next[key[k]]++] = static_cast<NodeIndex>(member(k));
+}
+
+}  // namespace
+
+void CellGrid::build(const NodeStore& store, std::size_t count, double min_cell_size) {
+    build_grid(*this, store, count, [](std::size_t k) { return k; }, min_cell_size);
+}
+
+void CellGrid::build(const NodeStore& store, const std::vector<NodeIndex>& members, double min_cell_size) {
+    build_grid(*this, store, members.size(), [&](std::size_t k) { return static_cast<std::size_t>(members[k]); }, min_cell_size);
+}
+
+DiameterSpread diameter_spread(const NodeStore& nodes, std::size_t count) {
+    DiameterSpread s;
+    if (count == 0) return s;
+    double sum = 0.0;
+    for (std::size_t i = 0; i < count; ++i) {
+        sum += nodes.diameter[i];
+        s.largest = std::max(s.largest, nodes.diameter[i]);
+    }
+    s.cut = 2.0 * sum / static_cast<double>(count);
+    if (!(s.largest > s.cut)) {
+        // Nothing outsized (or diameters that are not finite: the phases report those).
+        s.bulk = s.largest;
+        s.cut = std::max(s.cut, s.largest);
+        return s;
+    }
+    for (std::size_t i = 0; i < count; ++i) {
+        if (nodes.diameter[i] <= s.cut) s.bulk = std::max(s.bulk, nodes.diameter[i]);
+    }
+    return s;
+}
+
+double bulk_interaction_radius(const NodeStore& nodes, double a, std::size_t count) {
+    return 2.0 * a * diameter_spread(nodes, count).bulk;
 }
 
 std::array<std::size_t, 3> CellGrid::cell_of(const NodeStore& store, std::size_t i) const {
@@ -133,12 +172,29 @@ void find_neighbours(const NodeStore& nodes, InfluenceDistance influence, std::s
     // Cells of half the reach, and the 5 (or 5 x 5 x 5) cells around a centre's: the cells cover
     // 2.5 reaches across instead of 3, which spares about a third of the distance checks in 2D
     // and half in 3D. (The grid may enlarge its cells to bound their number; the span follows.)
-    const double reach = largest_interaction_radius(nodes, a, n) + skin;
-    if (search) scratch.grid.build(nodes, n, 0.5 * reach);
+    // The reach is that of the bulk of the nodes; outsized nodes (DiameterSpread) have a grid of
+    // their own, in cells of their reach, which every centre searches too.
+    const DiameterSpread spread = search ? diameter_spread(nodes, n) : DiameterSpread{};
+    const bool split = search && spread.any_outsized();
+    const double reach = 2.0 * a * spread.bulk + skin;
+    if (split) {
+        scratch.bulk.clear();
+        scratch.outsized.clear();
+        for (std::size_t i = 0; i < n; ++i) (nodes.diameter[i] > spread.cut ? scratch.outsized : scratch.bulk).push_back(static_cast<NodeIndex>(i));
+        scratch.grid.build(nodes, scratch.bulk, 0.5 * reach);
+        scratch.outsized_grid.build(nodes, scratch.outsized, 0.5 * (2.0 * a * spread.largest + skin));
+    } else if (search) {
+        scratch.grid.build(nodes, n, 0.5 * reach);
+    }
     const CellGrid& grid = scratch.grid;
     const int dim = nodes.dim();
     // A neighbour is less than `reach` away along each axis, so at most ceil(reach / edge) cells.
     const std::size_t span = search && grid.cell_size > 0.0 ? static_cast<std::size_t>(std::ceil(reach / grid.cell_size)) : 1;
+    // The cells an outsized centre i searches in the bulk grid: its pairs there are closer than
+    // a (d_i + d_bulk) + skin. In the outsized grid every centre searches a (d_i + d_largest) + skin.
+    const auto cells_within = [&](const CellGrid& g, double distance) {
+        return g.cell_size > 0.0 ? static_cast<std::size_t>(std::ceil(distance / g.cell_size)) : std::size_t{1};
+    };
 
     // Lattice pairs link two fixed nodes; a lattice neighbour that has switched is a variable pair
     // now, found by the search like any other node (spec section 2, mixed pairs).
@@ -167,31 +223,43 @@ void find_neighbours(const NodeStore& nodes, InfluenceDistance influence, std::s
             }
         }
         if (!search) return;
-        const auto home = grid.cell_of(nodes, i);
-        std::array<std::size_t, 3> lo{0, 0, 0}, hi{0, 0, 0};
-        for (int k = 0; k < dim; ++k) {
-            lo[k] = home[k] < span ? 0 : home[k] - span;
-            hi[k] = std::min(grid.cells[k] - 1, home[k] + span);
-        }
         const std::int32_t own_body = nodes.body[i];
-        std::array<std::size_t, 3> c{0, 0, 0};
-        for (c[2] = lo[2]; c[2] <= hi[2]; ++c[2]) {
-            for (c[1] = lo[1]; c[1] <= hi[1]; ++c[1]) {
-                for (c[0] = lo[0]; c[0] <= hi[0]; ++c[0]) {
-                    const std::size_t cell = grid.linear(c);
-                    for (std::size_t k = grid.cell_start[cell]; k < grid.cell_start[cell + 1]; ++k) {
-                        const NodeIndex j = grid.nodes[k];
-                        if (j == i) continue;
-                        if (fixed && nodes.body[j] == own_body) {
-                            // A lattice neighbour is in the row already; another fixed node of the
-                            // body is no pair of a fixed centre, but may become one when either switches.
-                            if (candidates ? lattice_neighbour(i, j) : nodes.connectivity[j] == Connectivity::Fixed) continue;
+        const auto scan = [&](const CellGrid& g, std::size_t cells_around) {
+            const auto home = g.cell_of(nodes, i);
+            std::array<std::size_t, 3> lo{0, 0, 0}, hi{0, 0, 0};
+            for (int k = 0; k < dim; ++k) {
+                lo[k] = home[k] < cells_around ? 0 : home[k] - cells_around;
+                hi[k] = std::min(g.cells[k] - 1, home[k] + cells_around);
+            }
+            std::array<std::size_t, 3> c{0, 0, 0};
+            for (c[2] = lo[2]; c[2] <= hi[2]; ++c[2]) {
+                for (c[1] = lo[1]; c[1] <= hi[1]; ++c[1]) {
+                    for (c[0] = lo[0]; c[0] <= hi[0]; ++c[0]) {
+                        const std::size_t cell = g.linear(c);
+                        for (std::size_t k = g.cell_start[cell]; k < g.cell_start[cell + 1]; ++k) {
+                            const NodeIndex j = g.nodes[k];
+                            if (j == i) continue;
+                            // The distance first: most nodes of the cells are out of reach, and the
+                            // lattice look-up below walks the centre's lattice row.
+                            if (!(skin > 0.0 ? is_candidate(nodes, a, skin, i, j) : is_pair(nodes, a, i, j))) continue;
+                            if (fixed && nodes.body[j] == own_body) {
+                                // A lattice neighbour is in the row already; another fixed node of the
+                                // body is no pair of a fixed centre, but may become one when either switches.
+                                if (candidates ? lattice_neighbour(i, j) : nodes.connectivity[j] == Connectivity::Fixed) continue;
+                            }
+                            emit(j);
                         }
-                        if (skin > 0.0 ? is_candidate(nodes, a, skin, i, j) : is_pair(nodes, a, i, j)) emit(j);
                     }
                 }
             }
+        };
+        if (!split) {
+            scan(grid, span);
+            return;
         }
+        const double d_i = nodes.diameter[i];
+        scan(grid, d_i > spread.cut ? cells_within(grid, a * (d_i + spread.bulk) + skin) : span);
+        scan(scratch.outsized_grid, cells_within(scratch.outsized_grid, a * (d_i + spread.largest) + skin));
     };
 
     // Two passes, count and fill, straight into the output: no per-block buffers, so the peak

@@ -58,23 +58,29 @@ void NeighbourLists::invalidate() {
 }
 
 void NeighbourLists::place_ghosts(NodeStore& nodes, std::size_t real, GhostSet& ghosts, InfluenceDistance influence_distance, bool first) {
-    const double range = largest_interaction_radius(nodes, influence_distance.value(), real);
-    if (with_skin_ && !search_due_) search_due_ = candidates_stale(nodes, real, ghosts, influence_distance, range);
+    const double a = influence_distance.value();
+    // The skin and the staleness follow the bulk of the nodes (DiameterSpread): the skin is a
+    // fraction of their interaction radius, whatever a few outsized nodes measure.
+    const double range = bulk_interaction_radius(nodes, a, real);
+    // Rounding of a ghost's mirrored coordinates against the search's r < 2 h_ij: a margin far
+    // below any spacing, so that a pair at the edge of its reach never misses its ghost.
+    const double rounding = 1e-9 * range;
+    if (with_skin_ && !search_due_) search_due_ = candidates_stale(nodes, real, ghosts, influence_distance, rounding);
     if (ghosts.empty()) return;
     ghosts.update_contacts(nodes, real, first);
     if (!with_skin_) {
-        ghosts.build(nodes, real, range);
+        ghosts.build(nodes, real, ghosts.pair_reach(nodes, real, a, rounding));
     } else if (search_due_) {
         // Ghosts for every node within the candidates' reach, kept until the next search.
         skin_ = solver_->neighbour_skin * range;
-        ghosts.build(nodes, real, range + skin_, true);
+        ghosts.build(nodes, real, ghosts.pair_reach(nodes, real, a, skin_ + rounding), true);
     } else {
         ghosts.update(nodes, real);
     }
 }
 
 bool NeighbourLists::candidates_stale(const NodeStore& nodes, std::size_t real, const GhostSet& ghosts,
-                                      InfluenceDistance influence_distance, double range) const {
+                                      InfluenceDistance influence_distance, double rounding) const {
     // A pair (i, j) left out by the last search had r >= 2 h_ij + skin then. Now r has shrunk by
     // at most |u_i - u_j| <= 2 max |u - U| (u the displacements since the search, U any common
     // translation: the middle of the u), and 2 h_ij has grown by at most 2 a max (d - d_then).
@@ -124,7 +130,7 @@ bool NeighbourLists::candidates_stale(const NodeStore& nodes, std::size_t real, 
         [](double x, double y) { return std::max(x, y); });
     double closing = 2.0 * std::sqrt(largest);
     if (!ghosts.empty()) {
-        if (!ghosts.covers(nodes, real, range)) return true;
+        if (!ghosts.covers(nodes, real, ghosts.pair_reach(nodes, real, influence_distance.value(), rounding))) return true;
         closing = std::max(closing, ghosts.mirrored_displacement_bound(nodes, real, searched_position_));
     }
     // NaN positions make the bound NaN: search, and let the phases report them.
@@ -142,6 +148,8 @@ void NeighbourLists::check_against_search(const NodeStore& nodes, std::size_t re
     NeighbourScratch scratch;
     const CompressedRows* mirrored = nullptr;
     if (!ghosts.empty()) {
+        // Ghosts for every node within the largest interaction radius of the planes, not the
+        // reach place_ghosts derives (GhostSet::pair_reach): the check holds that reach too.
         fresh_ghosts.build(copy, real, largest_interaction_radius(nodes, influence_distance.value(), real));
         mirrored = &fresh_ghosts.resolved_fixed_mirrors(copy, real);
     }
@@ -169,7 +177,7 @@ void NeighbourLists::check_against_search(const NodeStore& nodes, std::size_t re
 void NeighbourLists::search_candidates(NodeStore& nodes, std::size_t real, GhostSet& ghosts, InfluenceDistance influence_distance,
                                        bool any_automatic) {
     const CompressedRows* mirrored = ghosts.empty() ? nullptr : &ghosts.resolved_fixed_mirrors(nodes, real);
-    if (ghosts.empty()) skin_ = solver_->neighbour_skin * largest_interaction_radius(nodes, influence_distance.value(), real);
+    if (ghosts.empty()) skin_ = solver_->neighbour_skin * bulk_interaction_radius(nodes, influence_distance.value(), real);
     find_neighbours(nodes, influence_distance, real, candidates_, scratch_, mirrored, skin_, any_automatic);
     lattice_entries_.assign(real, 0);
     for (std::size_t i = 0; i < real; ++i) {

@@ -68,7 +68,7 @@ public:
 
 private:
     bool candidates_stale(const NodeStore& nodes, std::size_t real, const GhostSet& ghosts, InfluenceDistance influence_distance,
-                          double range) const;
+                          double rounding) const;
     void search_candidates(NodeStore& nodes, std::size_t real, GhostSet& ghosts, InfluenceDistance influence_distance,
                            bool any_automatic);
     void check_against_search(const NodeStore& nodes, std::size_t real, const GhostSet& ghosts, InfluenceDistance influence_distance,

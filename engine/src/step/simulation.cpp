@@ -211,7 +211,7 @@ void Simulation::Impl::regroup_materials() {
 
 void Simulation::Impl::reorder() {
     nodes.resize(real);  // ghosts are rebuilt after every move
-    const double cell = largest_interaction_radius(nodes, a().value(), real);
+    const double cell = bulk_interaction_radius(nodes, a().value(), real);
     nodes.permute(locality_order(nodes, cell, 0, real));
     neighbour_lists.invalidate();  // rebuilt in the new numbering by the neighbours phase
     regroup_materials();

@@ -30,6 +30,14 @@ struct GhostPlane {
     double distance(double coordinate) const { return side * (coordinate - position); }
 };
 
+// Which real nodes get ghosts: those closer to every plane of a corner combination than
+// base + per_diameter * d (their own diameter d). A fixed range is {range, 0}.
+struct GhostReach {
+    double base = 0.0;
+    double per_diameter = 0.0;
+    double of(double diameter) const { return base + per_diameter * diameter; }
+};
+
 class GhostSet {
 public:
     GhostSet() = default;
@@ -63,7 +71,19 @@ public:
     // every node within `range` gets its ghosts whatever its contact state, so that contacts can
     // change without a new set; the pairs of nodes out of contact are removed from the lists
     // every step instead (remove_pairs_without_contact), which gives the same pairs.
-    void build(NodeStore& nodes, std::size_t real_count, double range, bool keep_between_searches = false);
+    void build(NodeStore& nodes, std::size_t real_count, GhostReach reach, bool keep_between_searches = false);
+    void build(NodeStore& nodes, std::size_t real_count, double range, bool keep_between_searches = false) {
+        build(nodes, real_count, GhostReach{range, 0.0}, keep_between_searches);
+    }
+
+    // The reach the pairs need, with `margin` added (the skin of neighbour lists that are to
+    // serve several steps). A real node i and the ghost of a node j across a plane are at least
+    // dist_i + dist_j apart (their distances from the plane), and pair only when closer than
+    // 2 h_ij + margin = a (d_i + d_j) + margin; so j needs a ghost only when
+    // dist_j < a d_j + max_i (a d_i - dist_i) + margin, the maximum over the real nodes and the
+    // planes. (A reach of 2 a d_max for every node made each debris node of a fractured body
+    // that had grown to 30 times its diameter give ghosts to everything within 30 diameters.)
+    GhostReach pair_reach(const NodeStore& nodes, std::size_t real_count, double influence_distance, double margin) const;
 
     // Re-copies, for the ghosts of the last build, the fields that build() copies, from the
     // sources' current values (positions and velocities mirrored).
@@ -71,7 +91,7 @@ public:
 
     // True when the ghosts of the last build include every real node within `range` of all
     // planes of a corner combination (ignoring contact): the set still serves that range.
-    bool covers(const NodeStore& nodes, std::size_t real_count, double range) const;
+    bool covers(const NodeStore& nodes, std::size_t real_count, GhostReach reach) const;
 
     // A bound on how much the distance of any real node to any ghost has changed since the
     // positions `reference` (real nodes [0, real_count), taken at the last build): per corner
