@@ -9,8 +9,10 @@
 # slows down or speeds up during the run weighs on both alike):
 #   * gpa_bench_steps on the step cases (CASES, at NODES nodes, THREADS threads, STEPS steps after
 #     WARMUP warm-up steps): whole step and every phase, ms per step;
-#   * two whole scenes: the README main job (`gpa run`, the built-in Armco cylinder) and
-#     scenes/taylor-copper-190.toml, wall seconds of the whole run.
+#   * three whole scenes: the README main job (`gpa run`, the built-in Armco cylinder),
+#     scenes/taylor-copper-190.toml and scenes/hypervelocity-spall.toml at 0.8 mm (both bodies'
+#     spacing doubled: fracture, debris, switching, a search nearly every step), wall seconds of
+#     the whole run.
 # It prints medians over the rounds per case and per phase for both commits and their ratio
 # (base / head: above 1 means HEAD is faster). Medians and ratios are only comparable within one
 # run on one machine; quote them with the machine, the threads and the problem size.
@@ -66,7 +68,7 @@ mkdir -p "$raw"
 case_args=()
 for c in $cases; do case_args+=(--case "$c"); done
 
-# One round of one commit: the step benchmark, then the two scenes, each timed.
+# One round of one commit: the step benchmark, then the three scenes, each timed.
 run_round() {
   local sha=$1 tag=$2 k=$3 bld="$dir/$1/build" src="$dir/$1/src"
   (cd "$src" && "$bld/benchmarks/gpa_bench_steps" "${case_args[@]}" --nodes "$nodes" --threads "$threads" \
@@ -74,10 +76,15 @@ run_round() {
   if [[ "$with_scenes" == 1 ]]; then
     local out t0 t1
     out=$(mktemp -d)
-    for scene in main-job scenes/taylor-copper-190.toml; do
+    for scene in main-job scenes/taylor-copper-190.toml hypervelocity-spall-0.8mm; do
+      if [[ "$scene" == hypervelocity-spall-0.8mm ]]; then
+        sed 's/^spacing = "0.4 mm"/spacing = "0.8 mm"/' "$src/scenes/hypervelocity-spall.toml" >"$out/hypervelocity.toml"
+      fi
       t0=$(date +%s.%N)
       if [[ "$scene" == main-job ]]; then
         (cd "$src" && "$bld/apps/gpa" run -o "$out/run" --threads "$threads" -q --overwrite) >/dev/null
+      elif [[ "$scene" == hypervelocity-spall-0.8mm ]]; then
+        (cd "$src" && "$bld/apps/gpa" run "$out/hypervelocity.toml" -o "$out/run" --threads "$threads" -q --overwrite) >/dev/null
       else
         (cd "$src" && "$bld/apps/gpa" run "$scene" -o "$out/run" --threads "$threads" -q --overwrite) >/dev/null
       fi
