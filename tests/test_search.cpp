@@ -179,6 +179,41 @@ TEST(Search, GhostsWithinThePairsReachGiveEveryPairOfGhostsWithinTheLargestReach
     }
 }
 
+// With candidates that outlive switching, a fixed centre whose cells within reach hold only fixed
+// nodes of its body is quiet: its row is its lattice row alone. Next to another body or a
+// variable node it is not, and its row holds every node within reach.
+TEST(Search, AFixedCentreFarFromOtherBodiesAndVariableNodesIsQuiet) {
+    NodeStore n(GeometryKind::PlaneStrain);
+    for (int b = 0; b < 3; ++b) {
+        LatticeBlock blk;
+        blk.spacing = {0.02, 0.02, 0.02};
+        blk.origin = {b == 2 ? 0.3 : 0.0, b == 1 ? 0.3 : 0.0, 0.0};
+        blk.last = {15, 15, 1};
+        blk.body = b;
+        blk.connectivity = b == 2 ? Connectivity::Variable : Connectivity::Fixed;
+        fill_lattice(n, blk);
+    }
+    NeighbourScratch scratch;
+    CompressedRows candidates;
+    find_neighbours(n, 1.0, n.size(), candidates, scratch, nullptr, 0.01, true);
+    ASSERT_EQ(scratch.quiet.size(), n.size());
+    const std::size_t deep = 3 * 15 + 3, top = 14 * 15 + 3, side = 7 * 15 + 14;  // of body 0
+    EXPECT_EQ(scratch.quiet[deep], 1);
+    EXPECT_EQ(candidates.row_size(deep), n.fixed_neighbours.row_size(deep));
+    EXPECT_EQ(scratch.quiet[top], 0) << "body 1 is within reach";
+    EXPECT_GT(candidates.row_size(top), n.fixed_neighbours.row_size(top));
+    EXPECT_EQ(scratch.quiet[side], 0) << "the variable body 2 is within reach";
+    for (std::size_t i = 2 * 225; i < n.size(); ++i) ASSERT_EQ(scratch.quiet[i], 0) << "a variable centre is never quiet";
+    std::size_t quiet = 0;
+    for (auto q : scratch.quiet) quiet += q;
+    EXPECT_GT(quiet, 100u);
+    // Without candidates nothing is flagged, and the lists are those of the all-pairs loop.
+    CompressedRows lists;
+    find_neighbours(n, 1.0, n.size(), lists, scratch);
+    EXPECT_TRUE(scratch.quiet.empty());
+    expect_same_sets(lists, find_neighbours_brute_force(n, 1.0, n.size()));
+}
+
 TEST(Search, ResultDoesNotDependOnThreadCountOrScratchReuse) {
     auto n = random_cloud(GeometryKind::PlaneStrain, 5000, 3);
     const auto reference = find_neighbours(n, 1.0, n.size());

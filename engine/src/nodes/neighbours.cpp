@@ -188,6 +188,27 @@ void find_neighbours(const NodeStore& nodes, InfluenceDistance influence, std::s
     }
     const CellGrid& grid = scratch.grid;
     const int dim = nodes.dim();
+    // Which cells hold only fixed nodes of one body (NeighbourScratch::cell_body): a fixed centre
+    // whose cells within reach all do has no pair there but its lattice neighbours.
+    if (search) {
+        const std::size_t cell_count = grid.cell_start.size() - 1;
+        scratch.cell_body.resize(cell_count);
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cell_count, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
+            for (std::size_t cell = r.begin(); cell != r.end(); ++cell) {
+                std::int32_t state = NeighbourScratch::kEmptyCell;
+                for (std::size_t k = grid.cell_start[cell]; k < grid.cell_start[cell + 1] && state != NeighbourScratch::kMixedCell; ++k) {
+                    const NodeIndex j = grid.nodes[k];
+                    if (nodes.connectivity[j] != Connectivity::Fixed || (state >= 0 && state != nodes.body[j])) {
+                        state = NeighbourScratch::kMixedCell;
+                    } else {
+                        state = nodes.body[j];
+                    }
+                }
+                scratch.cell_body[cell] = state;
+            }
+        });
+    }
+    scratch.quiet.assign(candidates ? centres : 0, 0);
     // A neighbour is less than `reach` away along each axis, so at most ceil(reach / edge) cells.
     const std::size_t span = search && grid.cell_size > 0.0 ? static_cast<std::size_t>(std::ceil(reach / grid.cell_size)) : 1;
     // The cells an outsized centre i searches in the bulk grid: its pairs there are closer than
@@ -224,12 +245,33 @@ void find_neighbours(const NodeStore& nodes, InfluenceDistance influence, std::s
         }
         if (!search) return;
         const std::int32_t own_body = nodes.body[i];
-        const auto scan = [&](const CellGrid& g, std::size_t cells_around) {
+        // The cells of g within `cells_around` of the centre's, as a box of cell coordinates.
+        const auto box = [&](const CellGrid& g, std::size_t cells_around, std::array<std::size_t, 3>& lo, std::array<std::size_t, 3>& hi) {
             const auto home = g.cell_of(nodes, i);
-            std::array<std::size_t, 3> lo{0, 0, 0}, hi{0, 0, 0};
             for (int k = 0; k < dim; ++k) {
                 lo[k] = home[k] < cells_around ? 0 : home[k] - cells_around;
                 hi[k] = std::min(g.cells[k] - 1, home[k] + cells_around);
+            }
+        };
+        // True when every cell of the box holds only fixed nodes of the centre's body, or none.
+        const auto quiet_box = [&](const std::array<std::size_t, 3>& lo, const std::array<std::size_t, 3>& hi) {
+            std::array<std::size_t, 3> c{0, 0, 0};
+            for (c[2] = lo[2]; c[2] <= hi[2]; ++c[2]) {
+                for (c[1] = lo[1]; c[1] <= hi[1]; ++c[1]) {
+                    for (c[0] = lo[0]; c[0] <= hi[0]; ++c[0]) {
+                        const std::int32_t state = scratch.cell_body[grid.linear(c)];
+                        if (state != NeighbourScratch::kEmptyCell && state != own_body) return false;
+                    }
+                }
+            }
+            return true;
+        };
+        const auto scan = [&](const CellGrid& g, std::size_t cells_around) {
+            std::array<std::size_t, 3> lo{0, 0, 0}, hi{0, 0, 0};
+            box(g, cells_around, lo, hi);
+            if (fixed && &g == &grid && quiet_box(lo, hi)) {
+                if (candidates) scratch.quiet[i] = 1;
+                return;
             }
             std::array<std::size_t, 3> c{0, 0, 0};
             for (c[2] = lo[2]; c[2] <= hi[2]; ++c[2]) {

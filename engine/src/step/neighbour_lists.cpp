@@ -65,7 +65,9 @@ void NeighbourLists::place_ghosts(NodeStore& nodes, std::size_t real, GhostSet& 
     // Rounding of a ghost's mirrored coordinates against the search's r < 2 h_ij: a margin far
     // below any spacing, so that a pair at the edge of its reach never misses its ghost.
     const double rounding = 1e-9 * range;
-    if (with_skin_ && !search_due_) search_due_ = candidates_stale(nodes, real, ghosts, influence_distance, rounding);
+    if (with_skin_ && !search_due_) {
+        search_due_ = candidates_stale(nodes, real, ghosts, influence_distance, rounding) || switched_near_quiet_rows(nodes, real, ghosts);
+    }
     if (ghosts.empty()) return;
     ghosts.update_contacts(nodes, real, first);
     if (!with_skin_) {
@@ -137,6 +139,29 @@ bool NeighbourLists::candidates_stale(const NodeStore& nodes, std::size_t real, 
     return !(closing + 2.0 * influence_distance.value() * e.growth < skin_);
 }
 
+bool NeighbourLists::switched_near_quiet_rows(const NodeStore& nodes, std::size_t real, const GhostSet& ghosts) const {
+    // A quiet row lacks the fixed nodes of its body that are not its lattice neighbours; they
+    // become pairs only when one of the two switches. A node that switched since the search and
+    // was itself quiet lacks them all; one that was not holds every node within its reach in its
+    // candidates, so the quiet centres within its reach are in its row (a ghost entry names its
+    // source, whose row has the mirror image of the pair).
+    if (!any_quiet_) return false;
+    return tbb::parallel_reduce(
+        tbb::blocked_range<std::size_t>(0, real, reduce_grain), false,
+        [&](const tbb::blocked_range<std::size_t>& r, bool found) {
+            for (std::size_t i = r.begin(); i != r.end() && !found; ++i) {
+                if (!searched_fixed_[i] || nodes.connectivity[i] == Connectivity::Fixed) continue;
+                if (quiet_[i]) return true;
+                for (NodeIndex j : candidates_.row(i)) {
+                    const std::size_t centre = j < real ? j : ghosts.source(j - real);
+                    if (quiet_[centre]) return true;
+                }
+            }
+            return found;
+        },
+        [](bool x, bool y) { return x || y; });
+}
+
 void NeighbourLists::check_against_search(const NodeStore& nodes, std::size_t real, const GhostSet& ghosts,
                                           InfluenceDistance influence_distance, std::size_t step) const {
     // The pairs a step without a skin would have: fresh ghosts (only the nodes in contact across
@@ -179,6 +204,11 @@ void NeighbourLists::search_candidates(NodeStore& nodes, std::size_t real, Ghost
     const CompressedRows* mirrored = ghosts.empty() ? nullptr : &ghosts.resolved_fixed_mirrors(nodes, real);
     if (ghosts.empty()) skin_ = solver_->neighbour_skin * bulk_interaction_radius(nodes, influence_distance.value(), real);
     find_neighbours(nodes, influence_distance, real, candidates_, scratch_, mirrored, skin_, any_automatic);
+    quiet_.swap(scratch_.quiet);
+    quiet_.resize(real, 0);
+    any_quiet_ = std::find(quiet_.begin(), quiet_.end(), std::uint8_t{1}) != quiet_.end();
+    searched_fixed_.resize(real);
+    for (std::size_t i = 0; i < real; ++i) searched_fixed_[i] = nodes.connectivity[i] == Connectivity::Fixed;
     lattice_entries_.assign(real, 0);
     for (std::size_t i = 0; i < real; ++i) {
         if (nodes.connectivity[i] != Connectivity::Fixed) continue;
@@ -247,6 +277,8 @@ void NeighbourLists::write_state(StateWriter& out, int dim) const {
     out.value<std::uint64_t>(searches_);
     write_rows(out, candidates_);
     out.array(lattice_entries_);
+    out.array(quiet_);
+    out.array(searched_fixed_);
     for (int c = 0; c < dim; ++c) out.array(searched_position_[c]);
     out.array(searched_diameter_);
     write_plan(out, plan_);
@@ -261,6 +293,10 @@ void NeighbourLists::read_state(StateReader& in, int dim, std::size_t node_count
     searches_ = static_cast<std::size_t>(in.value<std::uint64_t>());
     read_rows(in, candidates_, std::numeric_limits<std::size_t>::max(), node_count);
     in.array(lattice_entries_);
+    in.array(quiet_);
+    in.array(searched_fixed_);
+    any_quiet_ = std::find(quiet_.begin(), quiet_.end(), std::uint8_t{1}) != quiet_.end();
+    if (quiet_.size() != searched_fixed_.size() || quiet_.size() != lattice_entries_.size()) in.fail("its neighbour lists are damaged");
     for (int c = 0; c < dim; ++c) in.array(searched_position_[c]);
     in.array(searched_diameter_);
     read_plan(in, plan_, node_count);
@@ -269,7 +305,8 @@ void NeighbourLists::read_state(StateReader& in, int dim, std::size_t node_count
 void NeighbourLists::memory_use(MemoryUse& out) const {
     add_memory(out, "neighbour lists: lists", allocated_bytes(lists_.indices) + allocated_bytes(lists_.offsets));
     add_memory(out, "neighbour lists: skin candidates", allocated_bytes(candidates_.indices) + allocated_bytes(candidates_.offsets) +
-                                                            allocated_bytes(lattice_entries_) + allocated_bytes(keep_scratch_));
+                                                            allocated_bytes(lattice_entries_) + allocated_bytes(keep_scratch_) +
+                                                            allocated_bytes(quiet_) + allocated_bytes(searched_fixed_));
     std::size_t searched = allocated_bytes(searched_diameter_);
     for (const auto& p : searched_position_) searched += allocated_bytes(p);
     add_memory(out, "neighbour lists: positions at the last search", searched);

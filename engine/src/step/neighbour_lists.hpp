@@ -69,6 +69,7 @@ public:
 private:
     bool candidates_stale(const NodeStore& nodes, std::size_t real, const GhostSet& ghosts, InfluenceDistance influence_distance,
                           double rounding) const;
+    bool switched_near_quiet_rows(const NodeStore& nodes, std::size_t real, const GhostSet& ghosts) const;
     void search_candidates(NodeStore& nodes, std::size_t real, GhostSet& ghosts, InfluenceDistance influence_distance,
                            bool any_automatic);
     void check_against_search(const NodeStore& nodes, std::size_t real, const GhostSet& ghosts, InfluenceDistance influence_distance,
@@ -85,6 +86,11 @@ private:
     NeighbourScratch scratch_;
     CompressedRows candidates_;
     std::vector<std::uint32_t> lattice_entries_;  // per row: how many leading candidates are lattice neighbours
+    // Per row: the centre was quiet at the last search (NeighbourScratch::quiet), and whether it
+    // was fixed then. A node that has switched since, with a quiet centre within its reach (or
+    // quiet itself), makes the candidates stale.
+    std::vector<std::uint8_t> quiet_, searched_fixed_;
+    bool any_quiet_ = false;
     std::vector<std::uint8_t> keep_scratch_;
     std::array<std::vector<double>, 3> searched_position_;
     std::vector<double> searched_diameter_;
