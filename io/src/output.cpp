@@ -653,6 +653,7 @@ void write_summary(const fs::path& file, const Simulation& sim, const RunSummary
     field("wall_seconds", json_number(run.wall_seconds));
     field("node_steps_per_second", json_number(stepping > 0.0 ? sim.node_steps() / stepping : 0.0));
     field("element_steps_per_second", json_number(stepping > 0.0 ? sim.element_steps() / stepping : 0.0));
+    field("neighbour_searches", std::to_string(sim.totals().neighbour_searches));
     field("snapshots", std::to_string(run.snapshots), true);
     j += "}\n";
     // In plane strain the bodies are slices of unit thickness: the extensive quantities (masses,

@@ -145,6 +145,9 @@ TEST(Summary, PlaneStrainKeysOfExtensiveQuantitiesArePerMetre) {
         // Intensive quantities keep their units.
         EXPECT_NE(text.find("\"time_s\":"), std::string::npos);
         EXPECT_NE(text.find("\"length_m\":"), std::string::npos);
+        // The searches the run made (the set-up's and any since), beside its timings.
+        EXPECT_NE(text.find(fmt::format("\"neighbour_searches\": {}", sim.totals().neighbour_searches)), std::string::npos) << text;
+        EXPECT_GE(sim.totals().neighbour_searches, 1u);
     }
     fs::remove_all(dir);
 }
