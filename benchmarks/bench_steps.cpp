@@ -8,9 +8,10 @@
 // Cases (all the OFHC copper bar of scenes/taylor-copper-190.toml, 25.4 mm x 7.62 mm at 190 m/s
 // onto a rigid anvil, Johnson-Cook, nodal viscosity, spacing scaled to the node count):
 //   2d-variable  axisymmetric, variable connectivity (the scene as it is)
-//   2d-fixed     axisymmetric, fixed connectivity (8 lattice neighbours)
+//   2d-fixed     axisymmetric, fixed connectivity (the default stencil: at the scene's a = 1.3,
+//                the box of 8 and every lattice node within 2 a d0, 20 neighbours)
 //   3d-variable  3D, the whole bar, variable connectivity
-//   3d-fixed     3D, fixed connectivity (26 lattice neighbours)
+//   3d-fixed     3D, fixed connectivity (the default stencil: 80 neighbours inside at a = 1.3)
 //
 // Each size and thread count gets its own Simulation, all started from the same state; after W
 // warm-up steps (the impact face is then in plastic flow) the simulations take turns to run K

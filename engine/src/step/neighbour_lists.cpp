@@ -59,22 +59,25 @@ void NeighbourLists::invalidate() {
 
 void NeighbourLists::place_ghosts(NodeStore& nodes, std::size_t real, GhostSet& ghosts, InfluenceDistance influence_distance, bool first) {
     const double a = influence_distance.value();
-    // The skin and the staleness follow the bulk of the nodes (DiameterSpread): the skin is a
-    // fraction of their interaction radius, whatever a few outsized nodes measure.
-    const double range = bulk_interaction_radius(nodes, a, real);
     // Rounding of a ghost's mirrored coordinates against the search's r < 2 h_ij: a margin far
-    // below any spacing, so that a pair at the edge of its reach never misses its ghost.
-    const double rounding = 1e-9 * range;
+    // below any spacing (a billionth of the bulk's interaction radius at the last search), so
+    // that a pair at the edge of its reach never misses its ghost.
     if (with_skin_ && !search_due_) {
+        const double rounding = 1e-9 * searched_range_;
         search_due_ = candidates_stale(nodes, real, ghosts, influence_distance, rounding) || switched_near_quiet_rows(nodes, real, ghosts);
     }
     if (ghosts.empty()) return;
+    // The skin follows the bulk of the nodes (DiameterSpread): a fraction of their interaction
+    // radius, whatever a few outsized nodes measure.
+    const double range = with_skin_ && !search_due_ ? searched_range_ : bulk_interaction_radius(nodes, a, real);
+    const double rounding = 1e-9 * range;
     ghosts.update_contacts(nodes, real, first);
     if (!with_skin_) {
         ghosts.build(nodes, real, ghosts.pair_reach(nodes, real, a, rounding));
     } else if (search_due_) {
         // Ghosts for every node within the candidates' reach, kept until the next search.
         skin_ = solver_->neighbour_skin * range;
+        searched_range_ = range;
         ghosts.build(nodes, real, ghosts.pair_reach(nodes, real, a, skin_ + rounding), true);
     } else {
         ghosts.update(nodes, real);
@@ -202,7 +205,10 @@ void NeighbourLists::check_against_search(const NodeStore& nodes, std::size_t re
 void NeighbourLists::search_candidates(NodeStore& nodes, std::size_t real, GhostSet& ghosts, InfluenceDistance influence_distance,
                                        bool any_automatic) {
     const CompressedRows* mirrored = ghosts.empty() ? nullptr : &ghosts.resolved_fixed_mirrors(nodes, real);
-    if (ghosts.empty()) skin_ = solver_->neighbour_skin * bulk_interaction_radius(nodes, influence_distance.value(), real);
+    if (ghosts.empty()) {
+        searched_range_ = bulk_interaction_radius(nodes, influence_distance.value(), real);
+        skin_ = solver_->neighbour_skin * searched_range_;
+    }
     find_neighbours(nodes, influence_distance, real, candidates_, scratch_, mirrored, skin_, any_automatic);
     quiet_.swap(scratch_.quiet);
     quiet_.resize(real, 0);
@@ -274,6 +280,7 @@ void NeighbourLists::write_state(StateWriter& out, int dim) const {
     out.value<std::uint8_t>(search_due_);
     out.value<std::uint8_t>(plan_due_);
     out.value<double>(skin_);
+    out.value<double>(searched_range_);
     out.value<std::uint64_t>(searches_);
     write_rows(out, candidates_);
     out.array(lattice_entries_);
@@ -290,6 +297,7 @@ void NeighbourLists::read_state(StateReader& in, int dim, std::size_t node_count
     search_due_ = in.value<std::uint8_t>() != 0;
     plan_due_ = in.value<std::uint8_t>() != 0;
     skin_ = in.value<double>();
+    searched_range_ = in.value<double>();
     searches_ = static_cast<std::size_t>(in.value<std::uint64_t>());
     read_rows(in, candidates_, std::numeric_limits<std::size_t>::max(), node_count);
     in.array(lattice_entries_);

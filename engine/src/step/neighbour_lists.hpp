@@ -82,6 +82,7 @@ private:
     bool search_due_ = true;
     bool plan_due_ = false;  // lists searched without a skin need a new scatter plan
     double skin_ = 0.0;
+    double searched_range_ = 0.0;  // the bulk's interaction radius at the last search (bulk_interaction_radius)
     std::size_t searches_ = 0;
     NeighbourScratch scratch_;
     CompressedRows candidates_;
