@@ -66,8 +66,9 @@ TEST(Search, NeighbourAtExactlyTwoHIsExcluded) {
     EXPECT_EQ(lists.row(0)[0], 2u);
 }
 
-TEST(Search, FixedCentresKeepLatticeNeighboursAndFindOtherBodies) {
-    // Two fixed-connectivity blocks touching at z = 0.3, and a variable block beside them.
+// Two fixed-connectivity blocks of 15 x 15 nodes touching at z = 0.3 (bodies 0 and 1), and a
+// variable block beside them at x = 0.3 (body 2).
+NodeStore two_fixed_blocks_and_a_variable_one() {
     NodeStore n(GeometryKind::PlaneStrain);
     for (int b = 0; b < 3; ++b) {
         LatticeBlock blk;
@@ -78,6 +79,11 @@ TEST(Search, FixedCentresKeepLatticeNeighboursAndFindOtherBodies) {
         blk.connectivity = b == 2 ? Connectivity::Variable : Connectivity::Fixed;
         fill_lattice(n, blk);
     }
+    return n;
+}
+
+TEST(Search, FixedCentresKeepLatticeNeighboursAndFindOtherBodies) {
+    NodeStore n = two_fixed_blocks_and_a_variable_one();
     testing::jitter(n, 0.1, 0.02, 9);
     const auto fast = find_neighbours(n, 1.0, n.size());
     expect_same_sets(fast, find_neighbours_brute_force(n, 1.0, n.size()));
@@ -183,16 +189,7 @@ TEST(Search, GhostsWithinThePairsReachGiveEveryPairOfGhostsWithinTheLargestReach
 // nodes of its body is quiet: its row is its lattice row alone. Next to another body or a
 // variable node it is not, and its row holds every node within reach.
 TEST(Search, AFixedCentreFarFromOtherBodiesAndVariableNodesIsQuiet) {
-    NodeStore n(GeometryKind::PlaneStrain);
-    for (int b = 0; b < 3; ++b) {
-        LatticeBlock blk;
-        blk.spacing = {0.02, 0.02, 0.02};
-        blk.origin = {b == 2 ? 0.3 : 0.0, b == 1 ? 0.3 : 0.0, 0.0};
-        blk.last = {15, 15, 1};
-        blk.body = b;
-        blk.connectivity = b == 2 ? Connectivity::Variable : Connectivity::Fixed;
-        fill_lattice(n, blk);
-    }
+    NodeStore n = two_fixed_blocks_and_a_variable_one();
     NeighbourScratch scratch;
     CompressedRows candidates;
     find_neighbours(n, 1.0, n.size(), candidates, scratch, nullptr, 0.01, true);
