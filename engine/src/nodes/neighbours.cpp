@@ -189,8 +189,11 @@ void find_neighbours(const NodeStore& nodes, InfluenceDistance influence, std::s
     const CellGrid& grid = scratch.grid;
     const int dim = nodes.dim();
     // Which cells hold only fixed nodes of one body (NeighbourScratch::cell_body): a fixed centre
-    // whose cells within reach all do has no pair there but its lattice neighbours.
-    if (search) {
+    // whose cells within reach all do has no pair there but its lattice neighbours. Only fixed
+    // centres look (an all-variable search makes no map).
+    bool any_fixed_centre = false;
+    for (std::size_t i = 0; i < centres && !any_fixed_centre; ++i) any_fixed_centre = nodes.connectivity[i] == Connectivity::Fixed;
+    if (search && any_fixed_centre) {
         const std::size_t cell_count = grid.cell_start.size() - 1;
         scratch.cell_body.resize(cell_count);
         tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cell_count, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
