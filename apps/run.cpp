@@ -20,6 +20,7 @@
 #include "gpa/engine/bodies.hpp"
 #include "gpa/engine/elements.hpp"
 #include "gpa/engine/errors.hpp"
+#include "gpa/engine/measure.hpp"
 #include "gpa/engine/simulation.hpp"
 #include "gpa/engine/state_io.hpp"
 #include "gpa/io/checkpoint.hpp"
@@ -281,7 +282,13 @@ void print_report(const Simulation& sim) {
     fmt::print("  {} real nodes, {} steps, t = {:.4g} us ({})\n", t.real_nodes, t.step, t.time * 1e6, sim.stop_reason());
     if (t.elements > 0) fmt::print("  {} elements, {} element nodes\n", t.elements, t.element_nodes);
     if (!t.planes.empty()) {
-        fmt::print("  final length {:.4g} mm, footprint diameter {:.4g} mm\n", t.length * 1e3, t.footprint_diameter * 1e3);
+        if (sim.nodes().dim() == 3) {
+            fmt::print("  final length {:.4g} mm, footprint diameter {:.4g} mm (the mean width over {} directions, {:.4g} to {:.4g} mm)\n",
+                       t.length * 1e3, t.footprint_diameter * 1e3, measure::footprint_directions, t.footprint_narrowest * 1e3,
+                       t.footprint_widest * 1e3);
+        } else {
+            fmt::print("  final length {:.4g} mm, footprint diameter {:.4g} mm\n", t.length * 1e3, t.footprint_diameter * 1e3);
+        }
     }
     fmt::print("  plastic work {:.4g} J, viscous work {:.4g} J, boundary work {:.3g} J, energy error {:+.3g} %\n",
                t.plastic_work, t.viscous_work, t.boundary_work, 100.0 * t.energy_error);

@@ -3,12 +3,15 @@
 // along the impact face; and the element reference (io/reference.hpp): the rule that makes a
 // study's series a reference, its file, the outline distance and the ratios.
 
+#include <array>
 #include <cmath>
+#include <numbers>
 #include <filesystem>
 #include <fstream>
 #include <string>
 #include <vector>
 
+#include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
 #include "gpa/engine/errors.hpp"
@@ -135,6 +138,88 @@ TEST(NodeDiameter, TheHoopStretchNeverShrinksTheSupport) {
     // The volume enters every rule alike; other geometries have no hoop stretch.
     EXPECT_DOUBLE_EQ(node_diameter<Axisymmetric>(1.0, 0.21, 1.0, 1.0, 2), 1.1);
     EXPECT_DOUBLE_EQ(node_diameter<PlaneStrain>(1.0, 0.21, 1.0, 2.0, 2), 1.1);
+}
+
+TEST(NodeDiameter, TheStretchRuleKeepsTheMostStretchedNeighboursInReach) {
+    // A face spread by l = 2 radially and around the hoop and thinned 4 times axially (J = 1):
+    // B = diag(l^2, l^2, 1 / l^4), its largest isochoric stretch is l, and the stretch rule makes
+    // d = l d0, so that a neighbour at l s0 along the face is where s0 was on the initial lattice.
+    const double l = 2.0;
+    const std::array<double, 6> face{l * l, l * l, 1.0 / (l * l * l * l), 0.0, 0.0, 0.0};
+    EXPECT_NEAR(largest_isochoric_stretch(face), l, 1e-14);
+    EXPECT_DOUBLE_EQ(node_diameter<ThreeD>(1.0, 0.0, 0.0, 0.0, 3, largest_isochoric_stretch(face)), largest_isochoric_stretch(face));
+    // A pure change of volume stretches nothing: the rule is the volume rule, d0 (V/V0)^(1/3).
+    const double j = 0.729;  // V/V0, cube root 0.9
+    const double c = std::cbrt(j * j);
+    EXPECT_NEAR(largest_isochoric_stretch({c, c, c, 0.0, 0.0, 0.0}), 1.0, 1e-14);
+    EXPECT_NEAR(node_diameter<ThreeD>(1.0, j - 1.0, 0.0, 0.0, 3, 1.0), 0.9, 1e-15);
+    EXPECT_DOUBLE_EQ(node_diameter<ThreeD>(1.0, j - 1.0, 0.0, 0.0, 2, 5.0), node_diameter<ThreeD>(1.0, j - 1.0, 0.0, 0.0, 1));
+    // The stretch does not depend on the axes: the face tensor turned by 30 degrees about z and
+    // 50 about x gives the same l.
+    const Eigen::Matrix3d turn = (Eigen::AngleAxisd(0.5236, Eigen::Vector3d::UnitZ()) *
+                                  Eigen::AngleAxisd(0.8727, Eigen::Vector3d::UnitX())).toRotationMatrix();
+    const Eigen::Matrix3d b = turn * Eigen::Vector3d(l * l, l * l, 1.0 / (l * l * l * l)).asDiagonal() * turn.transpose();
+    EXPECT_NEAR(largest_isochoric_stretch({b(0, 0), b(1, 1), b(2, 2), b(1, 2), b(0, 2), b(0, 1)}), l, 1e-13);
+    // In 2D the stretch rule is the hoop rule.
+    EXPECT_DOUBLE_EQ(node_diameter<Axisymmetric>(1.0, 0.0, 1.0, 2.0, 3, 7.0), node_diameter<Axisymmetric>(1.0, 0.0, 1.0, 2.0, 2));
+}
+
+TEST(LeftCauchyGreen, AdvancesAsTheProductOfTheStepsStretches) {
+    // A constant stretching L = diag(g, -g/4, -g/2): each step multiplies B's diagonal by
+    // (1 + dt L_aa)^2 exactly, and B stays diagonal.
+    const double g = 1e5, dt = 1e-8;
+    const int steps = 400;
+    Mat<3> L = Mat<3>::Zero();
+    L.diagonal() << g, -0.25 * g, -0.5 * g;
+    std::array<double, 6> b{1.0, 1.0, 1.0, 0.0, 0.0, 0.0};
+    for (int n = 0; n < steps; ++n) advance_left_cauchy_green(b, L, dt);
+    for (int a = 0; a < 3; ++a) EXPECT_NEAR(b[a], std::pow(1.0 + dt * L(a, a), 2 * steps), 1e-13 * b[a]) << a;
+    for (int a = 3; a < 6; ++a) EXPECT_EQ(b[a], 0.0);
+    // A spin W (skew) only turns F; the first-order step adds (dt w)^2 to B's diagonal in its plane
+    // each time, (I + dt W)(I + dt W)^T = I + (w dt)^2 diag(1, 1, 0): after n steps
+    // (1 + (w dt)^2)^n = 1.0004 here, a stretch of (1 + (w dt)^2)^(n/6) = 1 + 7e-5. That is the
+    // integration's error under rotation, O(dt) over a fixed time.
+    const double w = 1e5, x2 = (w * dt) * (w * dt);
+    Mat<3> spin = Mat<3>::Zero();
+    spin(0, 1) = -w;
+    spin(1, 0) = w;
+    std::array<double, 6> r{1.0, 1.0, 1.0, 0.0, 0.0, 0.0};
+    for (int n = 0; n < steps; ++n) advance_left_cauchy_green(r, spin, dt);
+    const double ulps = steps * 2.2e-16;  // one rounding per step
+    EXPECT_NEAR(r[0], std::pow(1.0 + x2, steps), ulps);
+    EXPECT_NEAR(r[1], std::pow(1.0 + x2, steps), ulps);
+    EXPECT_EQ(r[2], 1.0);
+    for (int a = 3; a < 6; ++a) EXPECT_EQ(r[a], 0.0) << a;
+    EXPECT_NEAR(largest_isochoric_stretch(r), std::pow(1.0 + x2, steps / 6.0), ulps);
+}
+
+TEST(Footprint3D, TheMeanWidthOverDirectionsOfASquareFace) {
+    // Cells of size d centred on an m x m square of side S = (m - 1) d on the plane z = 0, and one
+    // above the face: in direction theta the face is S (|cos| + |sin|) + d wide.
+    const double d = 1e-3;
+    const int m = 7;
+    const double side = (m - 1) * d;
+    measure::Extent e;
+    for (int i = 0; i < m; ++i)
+        for (int j = 0; j < m; ++j) measure::add_particle_3d(e, 0.5 * d, i * d + 0.3, j * d - 2.0, d);
+    measure::add_particle_3d(e, 5.0 * d, 50.0, 50.0, d);  // above the face: the length only
+    double mean = 0.0;
+    for (int k = 0; k < measure::footprint_directions; ++k) {
+        const double theta = k * std::numbers::pi / measure::footprint_directions;
+        const double expected = side * (std::abs(std::cos(theta)) + std::abs(std::sin(theta))) + d;
+        EXPECT_NEAR(e.width(k), expected, 1e-12) << k;
+        mean += expected / measure::footprint_directions;
+    }
+    EXPECT_NEAR(e.footprint(), mean, 1e-12);
+    EXPECT_NEAR(e.footprint_narrowest(), side + d, 1e-12);                   // along an edge
+    EXPECT_NEAR(e.footprint_widest(), side * std::sqrt(2.0) + d, 1e-12);     // across the diagonal (k = 9)
+    EXPECT_NEAR(e.length(), 5.5 * d, 1e-15);
+    // Merging two halves of the points gives the same extent as adding them all to one.
+    measure::Extent left, right;
+    for (int i = 0; i < m; ++i)
+        for (int j = 0; j < m; ++j) measure::add_particle_3d(i < 3 ? left : right, 0.5 * d, i * d + 0.3, j * d - 2.0, d);
+    left += right;
+    for (int k = 0; k < measure::footprint_directions; ++k) EXPECT_EQ(left.width(k), e.width(k));
 }
 
 // --- the element reference ----------------------------------------------------------------

@@ -1,6 +1,7 @@
 // Whole runs of the engine: energy and momentum balances, an elastic bar against a rigid plane,
 // smoothing, thread independence, and the phases a scene's graph holds.
 
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <random>
@@ -8,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "gpa/engine/ghosts.hpp"
+#include "gpa/engine/kernels.hpp"
 #include "gpa/engine/neighbours.hpp"
 #include "gpa/engine/simulation.hpp"
 #include "gpa/engine/smoothing.hpp"
@@ -141,6 +143,51 @@ Scene three_d_cylinder(int radial_cells) {
         scene.planes.push_back(p);
     }
     return scene;
+}
+
+// The 3D node diameter (SolverOptions::node_diameter, kernels.hpp): with "stretch" (the default)
+// each node carries B = F F^T and its d is d0 (V/V0)^(1/3) times B's largest isochoric stretch;
+// the impact face, spread radially, has the largest stretches. With "volume" B is not advanced at
+// all (the rule that does not need it costs nothing) and d is d0 (V/V0)^(1/3). Both runs are
+// bit-identical on 1 and 2 threads.
+TEST(NodeDiameter3D, TheStretchRuleFollowsTheImpactFaceAndTheVolumeRuleLeavesBAlone) {
+    for (NodeDiameter rule : {NodeDiameter::Stretch, NodeDiameter::Volume}) {
+        auto scene = three_d_cylinder(5);
+        scene.solver.node_diameter = rule;
+        Simulation one(scene, 1), two(scene, 2);
+        for (int k = 0; k < 150; ++k) {
+            one.step();
+            two.step();
+        }
+        EXPECT_TRUE(testing::node_bytes(one) == testing::node_bytes(two));
+        const NodeStore& n = one.nodes();
+        const double spacing = scene.bodies[0].spacing;
+        double largest = 1.0, largest_height = 0.0;
+        for (std::size_t i = 0; i < one.real_count(); ++i) {
+            std::array<double, 6> b;
+            for (int c = 0; c < 6; ++c) b[c] = n.left_cauchy_green[c][i];
+            const double lambda = largest_isochoric_stretch(b);
+            const double volume_rule = n.initial_diameter[i] * std::cbrt(1.0 + n.volumetric_strain[i]);
+            // The diameters are those of the last geometry phase, before this step's stress update
+            // advanced B and eps_v: within the step's increment (below 1 %) of the rule applied now.
+            if (rule == NodeDiameter::Volume) {
+                ASSERT_EQ(b, (std::array<double, 6>{1.0, 1.0, 1.0, 0.0, 0.0, 0.0})) << i;
+                ASSERT_NEAR(n.diameter[i], volume_rule, 0.01 * n.diameter[i]) << i;
+                continue;
+            }
+            ASSERT_NEAR(n.diameter[i], volume_rule * lambda, 0.01 * n.diameter[i]) << i;
+            if (lambda > largest) {
+                largest = lambda;
+                largest_height = n.position[2][i];
+            }
+        }
+        if (rule == NodeDiameter::Stretch) {
+            // 150 steps (about 9 us) after impact at 305 m/s the face has spread: its nodes are
+            // stretched well beyond 1, and the most stretched lies in the bottom two rows.
+            EXPECT_GT(largest, 1.3);
+            EXPECT_LT(largest_height, 2.0 * spacing);
+        }
+    }
 }
 
 TEST(NeighbourSkin, CutCandidatesEqualAFullSearchEveryStep) {

@@ -551,8 +551,12 @@ void write_summary(const fs::path& file, const Simulation& sim, const RunSummary
     field("element_nodes", std::to_string(t.element_nodes));
     field("elements", std::to_string(t.elements));
     field("threads", std::to_string(sim.threads()));
-    field("final", fmt::format("{{\"length_m\": {}, \"footprint_diameter_m\": {}, \"base_height_m\": {}, \"plastic_work_J\": {}}}",
-                               json_number(t.length), json_number(t.footprint_diameter), json_number(t.base_height),
+    // In 3D the footprint is the mean width over directions (measure.hpp), with its narrowest and widest.
+    const std::string spread = sim.nodes().dim() == 3 ? fmt::format(", \"footprint_narrowest_m\": {}, \"footprint_widest_m\": {}",
+                                                                     json_number(t.footprint_narrowest), json_number(t.footprint_widest))
+                                                         : std::string();
+    field("final", fmt::format("{{\"length_m\": {}, \"footprint_diameter_m\": {}{}, \"base_height_m\": {}, \"plastic_work_J\": {}}}",
+                               json_number(t.length), json_number(t.footprint_diameter), spread, json_number(t.base_height),
                                json_number(t.plastic_work)));
     {
         // Local peaks (measure.hpp): the mean over a neighbourhood of `radius_m`, where it is

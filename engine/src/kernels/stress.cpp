@@ -163,6 +163,15 @@ void update_stresses(NodeStore& nodes, std::size_t real_count, const std::vector
                 }
                 nodes.volumetric_strain[i] = eps_v;
                 nodes.volume[i] = volume;
+                if constexpr (D == 3) {
+                    if (options.left_cauchy_green) {
+                        auto& field = nodes.left_cauchy_green;
+                        std::array<double, 6> b;
+                        for (int c = 0; c < 6; ++c) b[c] = field[c][i];
+                        advance_left_cauchy_green(b, inc.velocity_gradient, dt);
+                        for (int c = 0; c < 6; ++c) field[c][i] = b[c];
+                    }
+                }
                 nodes.viscous_pressure[i] = q_new;
             }
         });

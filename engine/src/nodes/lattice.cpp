@@ -132,6 +132,9 @@ std::size_t fill_lattice(NodeStore& nodes, const LatticeBlock& block) {
         nodes.mass[i] = block.density * v0;
         nodes.initial_diameter[i] = d0;
         nodes.diameter[i] = d0;
+        if (nodes.dim() == 3) {
+            for (int c = 0; c < 6; ++c) nodes.left_cauchy_green[c][i] = c < 3 ? 1.0 : 0.0;
+        }
         nodes.body[i] = block.body;
         nodes.id[i] = static_cast<std::uint32_t>(i);  // the fill order (node_store.hpp)
         nodes.material[i] = block.material;

@@ -41,6 +41,7 @@ void NodeStore::for_each_field(F&& f) {
     for (int c = 0; c < d * d; ++c) f("velocity_gradient", velocity_gradient[c]);
     for (int c = 0; c < (d == 3 ? 3 : 1); ++c) f("alpha_shear", alpha_shear[c]);
     for (int c = 0; c < stress_components(d); ++c) f("deviatoric_stress", deviatoric_stress[c]);
+    for (int c = 0; c < (d == 3 ? 6 : 0); ++c) f("left_cauchy_green", left_cauchy_green[c]);
     f("mass", mass);
     f("volume", volume);
     f("initial_volume", initial_volume);

@@ -54,7 +54,8 @@ std::vector<SolverOption> make_table() {
     t.push_back({"node_diameter",
                  choice_of(&S::node_diameter, {{"hoop", NodeDiameter::Hoop},
                                                {"volume", NodeDiameter::Volume},
-                                               {"section", NodeDiameter::Section}}),
+                                               {"section", NodeDiameter::Section},
+                                               {"stretch", NodeDiameter::Stretch}}),
                  "how a particle node's diameter follows the deformation (section = Eq. 3 as printed)", ""});
     t.push_back({"weight", choice_of(&S::weight, {{"gpa", WeightKind::Gpa}, {"sph-nsf", WeightKind::SphNsf}}),
                  "variable-connectivity weight: GPA (Eq. 1b) or the SPH-NSF cubic spline (Eqs. 62-65)", ""});

@@ -11,6 +11,26 @@
 
 namespace gpa {
 
+namespace {
+
+// Node i into the extent above `plane` (measure.hpp): across the plane's first other axis (the
+// radius x in axisymmetric geometry) in 2D, along the footprint's directions in the plane in 3D.
+void add_to_extent(measure::Extent& e, const NodeStore& nodes, std::size_t i, const GhostPlane& plane, bool axisymmetric,
+                   double base) {
+    const int d = nodes.dim();
+    const double height = plane.distance(nodes.position[plane.axis][i]) - base;
+    const double cell = measure::particle_cell_size(nodes.size_weight[i], d);
+    const int first = plane.axis == 0 ? 1 : 0;
+    if (d == 3) {
+        const int second = plane.axis == 2 ? 1 : 2;
+        measure::add_particle_3d(e, height, nodes.position[first][i], nodes.position[second][i], cell);
+    } else {
+        measure::add_particle(e, height, nodes.position[first][i], cell, axisymmetric && first == 0);
+    }
+}
+
+}  // namespace
+
 NodeSums& NodeSums::operator+=(const NodeSums& o) {
     kinetic += o.kinetic;
     internal += o.internal;
@@ -54,13 +74,7 @@ NodeSums Measures::node_sums(const NodeStore& nodes, std::size_t real, const Gho
                 acc.viscous += m * nodes.viscous_work[i];
                 acc.variable += nodes.connectivity[i] == Connectivity::Variable;
                 acc.failed += nodes.failed[i] != 0;
-                if (plane) {
-                    // Width across the plane's first other axis (radius x in axisymmetric geometry).
-                    const int across = plane->axis == 0 ? 1 : 0;
-                    measure::add_particle(acc.extent, plane->distance(nodes.position[plane->axis][i]),
-                                          nodes.position[across][i], measure::particle_cell_size(nodes.size_weight[i], d),
-                                          axisymmetric && across == 0);
-                }
+                if (plane) add_to_extent(acc.extent, nodes, i, *plane, axisymmetric, 0.0);
             }
             return acc;
         },
@@ -69,14 +83,10 @@ NodeSums Measures::node_sums(const NodeStore& nodes, std::size_t real, const Gho
 
 measure::Extent Measures::particle_extent(const NodeStore& nodes, std::size_t real, const GhostPlane& plane, bool axisymmetric,
                                           double base) const {
-    const int across = plane.axis == 0 ? 1 : 0;
     return tbb::parallel_deterministic_reduce(
         tbb::blocked_range<std::size_t>(0, real, reduce_grain), measure::Extent{},
         [&](const tbb::blocked_range<std::size_t>& r, measure::Extent acc) {
-            for (std::size_t i = r.begin(); i != r.end(); ++i) {
-                measure::add_particle(acc, plane.distance(nodes.position[plane.axis][i]) - base, nodes.position[across][i],
-                                      measure::particle_cell_size(nodes.size_weight[i], nodes.dim()), axisymmetric && across == 0);
-            }
+            for (std::size_t i = r.begin(); i != r.end(); ++i) add_to_extent(acc, nodes, i, plane, axisymmetric, base);
             return acc;
         },
         [](measure::Extent x, const measure::Extent& y) { return x += y; });

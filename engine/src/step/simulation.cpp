@@ -235,14 +235,22 @@ void Simulation::Impl::move() {
 
 template <class G>
 void Simulation::Impl::geometry() {
-    // Node diameters (Eq. 3, or the volume rule of the solver's node_diameter) and size weights
+    // Node diameters (Eq. 3, or the rule of the solver's node_diameter: kernels.hpp) and size weights
     // (Eq. 4) at the new positions, with the volumes of the previous stress update; the gradient
     // and the next forces both use these.
-    const int diameter_rule = scene.solver.node_diameter == NodeDiameter::Section ? 0 : scene.solver.node_diameter == NodeDiameter::Volume ? 1 : 2;
+    const NodeDiameter rule = scene.solver.node_diameter;
+    const int diameter_rule = rule == NodeDiameter::Section ? 0 : rule == NodeDiameter::Volume ? 1 : rule == NodeDiameter::Hoop ? 2 : 3;
+    const bool stretch = G::dim == 3 && rule == NodeDiameter::Stretch;
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, real, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
         for (std::size_t i = r.begin(); i != r.end(); ++i) {
+            double lambda = 1.0;
+            if (stretch && !nodes.failed[i]) {  // a failed node is debris: its support follows its volume
+                std::array<double, 6> b;
+                for (int c = 0; c < 6; ++c) b[c] = nodes.left_cauchy_green[c][i];
+                lambda = largest_isochoric_stretch(b);
+            }
             nodes.diameter[i] = node_diameter<G>(nodes.initial_diameter[i], nodes.volumetric_strain[i],
-                                                 nodes.initial_position[0][i], nodes.position[0][i], diameter_rule);
+                                                 nodes.initial_position[0][i], nodes.position[0][i], diameter_rule, lambda);
         }
         update_size_weights(nodes, r.begin(), r.end());
     });
@@ -271,6 +279,7 @@ void Simulation::Impl::stress() {
     o.viscosity_quadratic = scene.solver.viscosity_quadratic;
     o.failure = scene.solver.failure;
     o.energy_booked_by_forces = ledger.compatible();
+    o.left_cauchy_green = G::dim == 3 && scene.solver.node_diameter == NodeDiameter::Stretch;
     update_stresses<G>(nodes, real, scene.materials, material_groups, dt_half, o);
 }
 
@@ -493,6 +502,8 @@ void Simulation::Impl::sum_totals() {
     }
     totals.length = plane ? shape.length() : 0.0;
     totals.footprint_diameter = plane ? shape.footprint() : 0.0;
+    totals.footprint_narrowest = plane ? shape.footprint_narrowest() : 0.0;
+    totals.footprint_widest = plane ? shape.footprint_widest() : 0.0;
     totals.real_nodes = real;
     totals.element_nodes = elements ? elements->mesh().nodes.size() : 0;
     totals.elements = elements ? elements->mesh().quads.size() : 0;
@@ -714,7 +725,7 @@ void Simulation::Impl::write_state(StateWriter& out) const {
     const Totals& t = totals;
     for (const double v : {t.time, t.time_step, t.kinetic_energy, t.internal_energy, t.plastic_work, t.viscous_work,
                            t.boundary_work, t.initial_kinetic_energy, t.initial_energy, t.energy_error, t.momentum[0],
-                           t.momentum[1], t.momentum[2], t.length, t.footprint_diameter, t.hourglass_work, t.hourglass_energy, t.energy_given}) {
+                           t.momentum[1], t.momentum[2], t.length, t.footprint_diameter, t.footprint_narrowest, t.footprint_widest, t.hourglass_work, t.hourglass_energy, t.energy_given}) {
         out.value<double>(v);
     }
     for (const std::size_t v : {t.step, t.real_nodes, t.ghost_nodes, t.variable_nodes, t.failed_nodes, t.pairs,
@@ -776,7 +787,7 @@ void Simulation::Impl::read_state(StateReader& in) {
     Totals& t = totals;
     for (double* v : {&t.time, &t.time_step, &t.kinetic_energy, &t.internal_energy, &t.plastic_work, &t.viscous_work,
                       &t.boundary_work, &t.initial_kinetic_energy, &t.initial_energy, &t.energy_error, &t.momentum[0],
-                      &t.momentum[1], &t.momentum[2], &t.length, &t.footprint_diameter, &t.hourglass_work, &t.hourglass_energy, &t.energy_given}) {
+                      &t.momentum[1], &t.momentum[2], &t.length, &t.footprint_diameter, &t.footprint_narrowest, &t.footprint_widest, &t.hourglass_work, &t.hourglass_energy, &t.energy_given}) {
         *v = in.value<double>();
     }
     for (std::size_t* v : {&t.step, &t.real_nodes, &t.ghost_nodes, &t.variable_nodes, &t.failed_nodes, &t.pairs,

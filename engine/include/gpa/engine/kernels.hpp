@@ -5,6 +5,7 @@
 // (Comput. Mech. 25, 2000), restated in shared/spec/gpa-method.md.
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 
@@ -283,6 +284,32 @@ inline double lattice_cell_ratio(const Mat<D>& current_edges, const Mat<D>& init
     return current_edges.determinant() / initial_edges.determinant();
 }
 
+// The left Cauchy-Green tensor B = F F^T of a node (3D), carried from step to step for the
+// stretch rule of the node diameter below. The deformation gradient obeys dF/dt = L F; over a step
+// with the velocity gradient L of the gradient phase, F^{n+1} = (I + dt L) F^n, so
+//   B^{n+1} = (I + dt L) B^n (I + dt L)^T,
+// first order in dt like the volumetric strain of Eq. 13, and symmetric positive definite for any
+// step with det(I + dt L) != 0 (a congruence of B^n). Components in the stress order of geometry.hpp
+// (xx, yy, zz, yz, xz, xy).
+// The 3x3 matrix of a symmetric tensor stored in the stress order (xx, yy, zz, yz, xz, xy).
+inline Mat<3> symmetric_matrix(const std::array<double, 6>& b) {
+    Mat<3> m;
+    m << b[0], b[5], b[4], b[5], b[1], b[3], b[4], b[3], b[2];
+    return m;
+}
+
+inline void advance_left_cauchy_green(std::array<double, 6>& b, const Mat<3>& L, double dt) {
+    const Mat<3> step = Mat<3>::Identity() + dt * L;
+    const Mat<3> m = step * symmetric_matrix(b) * step.transpose();
+    b = {m(0, 0), m(1, 1), m(2, 2), 0.5 * (m(1, 2) + m(2, 1)), 0.5 * (m(0, 2) + m(2, 0)), 0.5 * (m(0, 1) + m(1, 0))};
+}
+
+// The largest principal stretch of B's volume-preserving part, lambda = sqrt(mu_max / det(B)^(1/3))
+// with mu_max B's largest eigenvalue: 1 for a pure change of volume, >= 1 always (the isochoric
+// stretches multiply to 1). A face spread radially and around the hoop by l and thinned axially by
+// 1 / l^2 has lambda = l.
+double largest_isochoric_stretch(const std::array<double, 6>& b);
+
 // Eq. 3 and its plane-strain and 3D analogues (spec section 2):
 //   axisymmetric d = d0 sqrt((1 + eps_v) x0 / x), plane strain d = d0 sqrt(1 + eps_v),
 //   3D d = d0 (1 + eps_v)^(1/3).
@@ -292,14 +319,17 @@ inline double lattice_cell_ratio(const Mat<D>& current_edges, const Mat<D>& init
 // stretched radially and around the hoop and thinned axially; Eq. 3 shrinks its d by
 // 1 / sqrt(lambda) while its radial neighbours move lambda times further away, so that they leave
 // the radius of influence (at lambda = 1.4 a radial neighbour already weighs R = 0.1 instead of 0.5).
-// rule: 0 Eq. 3 (section), 1 volume, 2 hoop (max(x / x0, x0 / x) in place of x0 / x).
+// rule: 0 Eq. 3 (section), 1 volume, 2 hoop (max(x / x0, x0 / x) in place of x0 / x), 3 stretch
+// (3D: d = d0 (1 + eps_v)^(1/3) lambda, lambda the largest isochoric stretch above, so that the
+// neighbours along the most stretched direction keep their initial distance in units of d; in 2D
+// the same as hoop).
 template <class G>
-inline double node_diameter(double d0, double eps_v, double x0, double x, int rule = 0) {
+inline double node_diameter(double d0, double eps_v, double x0, double x, int rule = 0, double stretch = 1.0) {
     if constexpr (G::dim == 3) {
-        return d0 * std::cbrt(1.0 + eps_v);
+        return rule == 3 ? d0 * std::cbrt(1.0 + eps_v) * stretch : d0 * std::cbrt(1.0 + eps_v);
     } else if constexpr (G::axisymmetric) {
         if (rule == 1) return d0 * std::sqrt(1.0 + eps_v);
-        if (rule == 2) return d0 * std::sqrt((1.0 + eps_v) * std::max(x / x0, x0 / x));
+        if (rule >= 2) return d0 * std::sqrt((1.0 + eps_v) * std::max(x / x0, x0 / x));
         return d0 * std::sqrt((1.0 + eps_v) * x0 / x);
     } else {
         return d0 * std::sqrt(1.0 + eps_v);

@@ -25,12 +25,22 @@
 //
 // In an axisymmetric body the footprint is a diameter: a span [lo, hi] of radii counts as
 // [-hi, hi] (the body is symmetric about the axis).
+//
+// In 3D the footprint is a width in the plane, and the width of a face depends on the direction it
+// is taken in (a square's is sqrt(2) times wider across its diagonal; a Taylor bar's face spreads
+// in spokes along the lattice's rows). Its spans are kept along `footprint_directions` directions
+// u_k = cos(theta_k) e1 + sin(theta_k) e2, theta_k = k pi / K, k = 0 .. K - 1, in the plane's other
+// two axes (e1 before e2): a particle's span along u_k is [u_k . p - d/2, u_k . p + d/2] (its cell
+// reaches d/2 every way), an element node's [u_k . p, u_k . p]. The footprint is the mean of the
+// K widths (the mean width of a convex outline; pi D for its perimeter); footprint_narrowest and
+// footprint_widest give their spread.
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstddef>
 #include <limits>
+#include <numbers>
 #include <span>
 #include <string>
 #include <vector>
@@ -42,17 +52,32 @@ namespace gpa::measure {
 // Heights passed to add_particle and add_element_node are taken from a base: the plane (base 0)
 // in a first pass; when that pass finds no point on the plane (standing() is false) the caller
 // repeats it with heights less lowest() (the body's underside), as measure_extent does.
+inline constexpr int footprint_directions = 36;  // K: every 5 degrees
+
 struct Extent {
     double top = -std::numeric_limits<double>::infinity();
     double lowest = std::numeric_limits<double>::infinity();
     double face_lo = std::numeric_limits<double>::infinity();
     double face_hi = -std::numeric_limits<double>::infinity();
+    // 3D only (`planar` set by add_particle_3d / add_element_node_3d): the face's span along each u_k.
+    bool planar = false;
+    std::array<double, footprint_directions> direction_lo;
+    std::array<double, footprint_directions> direction_hi;
 
+    Extent() {
+        direction_lo.fill(std::numeric_limits<double>::infinity());
+        direction_hi.fill(-std::numeric_limits<double>::infinity());
+    }
     Extent& operator+=(const Extent& o) {
         top = std::max(top, o.top);
         lowest = std::min(lowest, o.lowest);
         face_lo = std::min(face_lo, o.face_lo);
         face_hi = std::max(face_hi, o.face_hi);
+        planar = planar || o.planar;
+        for (int k = 0; k < footprint_directions; ++k) {
+            direction_lo[k] = std::min(direction_lo[k], o.direction_lo[k]);
+            direction_hi[k] = std::max(direction_hi[k], o.direction_hi[k]);
+        }
         return *this;
     }
     bool seen() const { return top > -std::numeric_limits<double>::infinity(); }
@@ -60,9 +85,42 @@ struct Extent {
     bool standing() const { return face_hi >= face_lo; }
     // Final length: the highest point above the base (0 when nothing was seen).
     double length() const { return seen() ? top : 0.0; }
-    // Footprint diameter: the width of the points on the base (0 when none is on it).
-    double footprint() const { return face_hi > face_lo ? face_hi - face_lo : 0.0; }
+    // The face's width along u_k (3D) or across (2D); 0 when no point is on the base.
+    double width(int k) const {
+        if (!planar) return face_hi > face_lo ? face_hi - face_lo : 0.0;
+        return direction_hi[k] > direction_lo[k] ? direction_hi[k] - direction_lo[k] : 0.0;
+    }
+    // Footprint diameter: the width of the points on the base; in 3D the mean over the directions.
+    double footprint() const {
+        if (!planar) return width(0);
+        double sum = 0.0;
+        for (int k = 0; k < footprint_directions; ++k) sum += width(k);
+        return sum / footprint_directions;
+    }
+    double footprint_narrowest() const {
+        double w = width(0);
+        for (int k = 1; planar && k < footprint_directions; ++k) w = std::min(w, width(k));
+        return w;
+    }
+    double footprint_widest() const {
+        double w = width(0);
+        for (int k = 1; planar && k < footprint_directions; ++k) w = std::max(w, width(k));
+        return w;
+    }
 };
+
+// (cos theta_k, sin theta_k) of the footprint's directions.
+inline const std::array<std::array<double, 2>, footprint_directions>& footprint_direction_table() {
+    static const auto table = [] {
+        std::array<std::array<double, 2>, footprint_directions> t{};
+        for (int k = 0; k < footprint_directions; ++k) {
+            const double theta = k * std::numbers::pi / footprint_directions;
+            t[static_cast<std::size_t>(k)] = {std::cos(theta), std::sin(theta)};
+        }
+        return t;
+    }();
+    return table;
+}
 
 // The size of a particle node's cell, which the measurement rules take as its d: the square root
 // of its section A (its size weight W, Eq. 4) in 2D, the cube root of its volume in 3D. With Eq. 3
@@ -78,6 +136,24 @@ inline void add_particle(Extent& e, double height, double across, double diamete
     if (height < diameter) {
         e.face_hi = std::max(e.face_hi, across + half);
         e.face_lo = std::min(e.face_lo, axisymmetric ? -(across + half) : across - half);
+    }
+}
+
+// A 3D particle node at `height` above the base, at (a, b) along the plane's other two axes.
+inline void add_particle_3d(Extent& e, double height, double a, double b, double diameter) {
+    const double half = 0.5 * diameter;
+    e.planar = true;
+    e.top = std::max(e.top, height + half);
+    e.lowest = std::min(e.lowest, height - half);
+    if (height < diameter) {
+        e.face_hi = std::max(e.face_hi, a + half);
+        e.face_lo = std::min(e.face_lo, a - half);
+        const auto& u = footprint_direction_table();
+        for (int k = 0; k < footprint_directions; ++k) {
+            const double along = u[static_cast<std::size_t>(k)][0] * a + u[static_cast<std::size_t>(k)][1] * b;
+            e.direction_lo[k] = std::min(e.direction_lo[k], along - half);
+            e.direction_hi[k] = std::max(e.direction_hi[k], along + half);
+        }
     }
 }
 

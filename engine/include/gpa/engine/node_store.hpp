@@ -69,6 +69,10 @@ public:
     std::vector<double> damage;                    // Johnson-Cook damage D
     std::vector<double> plastic_work;              // accumulated specific plastic work, J/kg
     std::vector<double> viscous_work;              // accumulated specific artificial-viscous work, J/kg
+    // 3D only: the left Cauchy-Green tensor B = F F^T (kernels.hpp, advance_left_cauchy_green), in
+    // the stress order; the identity when a body is filled. Carried while the node diameter follows
+    // the stretch (SolverOptions::node_diameter), the identity otherwise.
+    std::array<std::vector<double>, 6> left_cauchy_green;
     std::vector<std::uint8_t> failed;              // 1 once the node has failed (no deviator, no tension)
     std::vector<std::uint8_t> plane_contact;       // bit p: in contact with lift-off plane p (ghosts.hpp)
     std::vector<std::uint8_t> velocity_region;     // 0: free; k + 1: held by Scene::prescribed_velocities[k] (prescribed.hpp)

@@ -182,13 +182,19 @@ enum class NodeDiameter {
     // d = d0 sqrt((1 + eps_v) max(x / x0, x0 / x)) in axisymmetric geometry: the hoop stretch
     // lambda = x / x0 enlarges the support whichever way it goes; the same as Volume otherwise.
     Hoop,
+    // 3D: d = d0 (V / V0)^(1/3) lambda, lambda the largest principal stretch of the node's
+    // volume-preserving deformation (kernels.hpp, largest_isochoric_stretch), so that the support
+    // reaches the neighbours of the most stretched direction as it did on the initial lattice; a
+    // failed node's follows its volume alone. In 2D the same as Hoop (the hoop stretch is the one
+    // an axisymmetric node carries). The default.
+    Stretch,
 };
 
 struct SolverOptions {
     ConnectivityMode connectivity = ConnectivityMode::Variable;
     double switch_plastic_strain = 0.1;  // Automatic: switch at this equivalent plastic strain
     double influence_distance = 1.0;     // a, 0.8-1.5 (Eq. 2)
-    NodeDiameter node_diameter = NodeDiameter::Hoop;
+    NodeDiameter node_diameter = NodeDiameter::Stretch;
     WeightKind weight = WeightKind::Gpa;
     Normalisation normalisation = Normalisation::PerDirection;
     ViscosityKind viscosity = ViscosityKind::Nodal;

@@ -109,7 +109,11 @@ struct Totals {
     // (docs/measurement.md): particles reach d/2 beyond their centres, element nodes lie on the
     // boundary.
     double length = 0.0;              // highest point above the base, m
-    double footprint_diameter = 0.0;  // width of the body on its base, m
+    double footprint_diameter = 0.0;  // width of the body on its base, m (3D: the mean over directions)
+    // 3D: the narrowest and widest of the widths the footprint is the mean of (measure.hpp); in 2D
+    // both are the footprint.
+    double footprint_narrowest = 0.0;
+    double footprint_widest = 0.0;
     double base_height = 0.0;         // the base above the plane: 0 while the body stands on it, m
     // Local peaks (measure.hpp, docs/measurement.md): equivalent plastic strain and temperature,
     // each the largest mean over a neighbourhood of `local_radius`, with where it is and the largest
@@ -219,7 +223,7 @@ public:
     // Reads the header of a checkpoint (no Simulation needed). Throws CheckpointError.
     static CheckpointInfo checkpoint_info(std::istream& in, std::uint64_t size, const std::string& source);
     // The format version save_checkpoint writes.
-    static constexpr std::uint32_t checkpoint_format = 5;  // 4: a section per part of the step; 5: element bodies
+    static constexpr std::uint32_t checkpoint_format = 6;  // 4: a section per part of the step; 5: element bodies; 6: B of 3D nodes
 
 private:
     struct Impl;

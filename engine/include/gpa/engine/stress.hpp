@@ -24,6 +24,9 @@ struct StressPhaseOptions {
     // The engine books the stress work after the velocity update (compatible energy): the point
     // update keeps e and reads its pressure from the EOS at the new density.
     bool energy_booked_by_forces = false;
+    // 3D: advance each node's B = F F^T (NodeStore::left_cauchy_green), for the stretch rule of the
+    // node diameter.
+    bool left_cauchy_green = false;
 };
 
 // Advances nodes [0, real_count) over dt from the velocity gradient of the gradient phase.
