@@ -284,13 +284,6 @@ inline double lattice_cell_ratio(const Mat<D>& current_edges, const Mat<D>& init
     return current_edges.determinant() / initial_edges.determinant();
 }
 
-// The left Cauchy-Green tensor B = F F^T of a node (3D), carried from step to step for the
-// stretch rule of the node diameter below. The deformation gradient obeys dF/dt = L F; over a step
-// with the velocity gradient L of the gradient phase, F^{n+1} = (I + dt L) F^n, so
-//   B^{n+1} = (I + dt L) B^n (I + dt L)^T,
-// first order in dt like the volumetric strain of Eq. 13, and symmetric positive definite for any
-// step with det(I + dt L) != 0 (a congruence of B^n). Components in the stress order of geometry.hpp
-// (xx, yy, zz, yz, xz, xy).
 // The 3x3 matrix of a symmetric tensor stored in the stress order (xx, yy, zz, yz, xz, xy).
 inline Mat<3> symmetric_matrix(const std::array<double, 6>& b) {
     Mat<3> m;
@@ -298,6 +291,13 @@ inline Mat<3> symmetric_matrix(const std::array<double, 6>& b) {
     return m;
 }
 
+// The left Cauchy-Green tensor B = F F^T of a node (3D), carried from step to step for the
+// stretch rule of the node diameter below. The deformation gradient obeys dF/dt = L F; over a step
+// with the velocity gradient L of the gradient phase, F^{n+1} = (I + dt L) F^n, so
+//   B^{n+1} = (I + dt L) B^n (I + dt L)^T,
+// first order in dt like the volumetric strain of Eq. 13, and symmetric positive definite for any
+// step with det(I + dt L) != 0 (a congruence of B^n). Components in the stress order of geometry.hpp
+// (xx, yy, zz, yz, xz, xy).
 inline void advance_left_cauchy_green(std::array<double, 6>& b, const Mat<3>& L, double dt) {
     const Mat<3> step = Mat<3>::Identity() + dt * L;
     const Mat<3> m = step * symmetric_matrix(b) * step.transpose();
