@@ -59,12 +59,16 @@ struct Extent {
     double lowest = std::numeric_limits<double>::infinity();
     double face_lo = std::numeric_limits<double>::infinity();
     double face_hi = -std::numeric_limits<double>::infinity();
-    // 3D only (`planar` set by add_particle_3d / add_element_node_3d): the face's span along each u_k.
+    // 3D only (`planar` set by add_particle_3d): the face's span along each u_k. Filled when the
+    // first 3D point arrives, so that a 2D extent (reduced over many ranges every step) carries
+    // zeros it never reads.
     bool planar = false;
-    std::array<double, footprint_directions> direction_lo;
-    std::array<double, footprint_directions> direction_hi;
+    std::array<double, footprint_directions> direction_lo{};
+    std::array<double, footprint_directions> direction_hi{};
 
-    Extent() {
+    void make_planar() {
+        if (planar) return;
+        planar = true;
         direction_lo.fill(std::numeric_limits<double>::infinity());
         direction_hi.fill(-std::numeric_limits<double>::infinity());
     }
@@ -73,10 +77,12 @@ struct Extent {
         lowest = std::min(lowest, o.lowest);
         face_lo = std::min(face_lo, o.face_lo);
         face_hi = std::max(face_hi, o.face_hi);
-        planar = planar || o.planar;
-        for (int k = 0; k < footprint_directions; ++k) {
-            direction_lo[k] = std::min(direction_lo[k], o.direction_lo[k]);
-            direction_hi[k] = std::max(direction_hi[k], o.direction_hi[k]);
+        if (o.planar) {
+            make_planar();
+            for (int k = 0; k < footprint_directions; ++k) {
+                direction_lo[k] = std::min(direction_lo[k], o.direction_lo[k]);
+                direction_hi[k] = std::max(direction_hi[k], o.direction_hi[k]);
+            }
         }
         return *this;
     }
@@ -142,7 +148,7 @@ inline void add_particle(Extent& e, double height, double across, double diamete
 // A 3D particle node at `height` above the base, at (a, b) along the plane's other two axes.
 inline void add_particle_3d(Extent& e, double height, double a, double b, double diameter) {
     const double half = 0.5 * diameter;
-    e.planar = true;
+    e.make_planar();
     e.top = std::max(e.top, height + half);
     e.lowest = std::min(e.lowest, height - half);
     if (height < diameter) {
