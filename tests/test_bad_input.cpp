@@ -64,6 +64,15 @@ TEST(BadInput, AxisymmetricNodeOnTheAxis) {
     EXPECT_NE(m.find("x > 0"), std::string::npos) << m;
 }
 
+TEST(BadInput, AThreeDNodeWithoutItsStretchTensorNamesTheNode) {
+    auto n = small_lattice(GeometryKind::ThreeD);
+    EXPECT_NO_THROW(validate_nodes(n));  // filled with B = I
+    for (int c = 0; c < 6; ++c) n.left_cauchy_green[c][4] = 0.0;
+    const auto m = message_of<InputError>([&] { validate_nodes(n); });
+    EXPECT_NE(m.find("node 4"), std::string::npos) << m;
+    EXPECT_NE(m.find("Cauchy-Green"), std::string::npos) << m;
+}
+
 TEST(BadInput, InfluenceDistanceOutsideItsRange) {
     auto n = small_lattice();
     for (double a : {0.79, 1.51, 0.0, -1.0, std::numeric_limits<double>::quiet_NaN()}) {

@@ -25,7 +25,7 @@ std::string totals_bytes(const Totals& t) {
     const auto add = [&](const auto& v) { out.append(reinterpret_cast<const char*>(&v), sizeof v); };
     for (const double v : {t.time, t.time_step, t.kinetic_energy, t.internal_energy, t.plastic_work, t.viscous_work,
                            t.boundary_work, t.energy_error, t.momentum[0], t.momentum[1], t.momentum[2], t.length,
-                           t.footprint_diameter}) {
+                           t.footprint_diameter, t.footprint_narrowest, t.footprint_widest}) {
         add(v);
     }
     for (const std::size_t v : {t.step, t.real_nodes, t.ghost_nodes, t.variable_nodes, t.failed_nodes, t.pairs,

@@ -220,6 +220,16 @@ TEST(Footprint3D, TheMeanWidthOverDirectionsOfASquareFace) {
         for (int j = 0; j < m; ++j) measure::add_particle_3d(i < 3 ? left : right, 0.5 * d, i * d + 0.3, j * d - 2.0, d);
     left += right;
     for (int k = 0; k < measure::footprint_directions; ++k) EXPECT_EQ(left.width(k), e.width(k));
+    // A reduction starts from an empty extent on either side of the merge.
+    measure::Extent empty_first;
+    empty_first += e;
+    measure::Extent empty_second = e;
+    empty_second += measure::Extent{};
+    for (int k = 0; k < measure::footprint_directions; ++k) {
+        EXPECT_EQ(empty_first.width(k), e.width(k)) << k;
+        EXPECT_EQ(empty_second.width(k), e.width(k)) << k;
+    }
+    EXPECT_EQ(measure::Extent{}.footprint(), 0.0);
 }
 
 // --- the element reference ----------------------------------------------------------------

@@ -192,6 +192,11 @@ void validate_nodes(const NodeStore& nodes, std::size_t first, std::size_t last)
         positive(nodes.volume, "volume");
         positive(nodes.size_weight, "size weight W (area or volume)");
         positive(nodes.diameter, "diameter");
+        if (d == 3) {
+            // B = F F^T is positive definite: a node made without it (all zero) would silently follow
+            // its volume alone under the stretch rule.
+            for (int c = 0; c < 3; ++c) positive(nodes.left_cauchy_green[c], "left Cauchy-Green tensor B (diagonal)");
+        }
     }
 }
 

@@ -36,7 +36,7 @@ std::string format_bytes(double bytes) {
     return u == 0 ? fmt::format("{:.0f} B", bytes) : fmt::format("{:.3g} {}", bytes, units[u]);
 }
 
-double bytes_per_node_besides_lists(int dim) { return dim == 3 ? 2.0 * 445.0 + 200.0 : 2.0 * 350.0 + 320.0; }
+double bytes_per_node_besides_lists(int dim) { return dim == 3 ? 2.0 * 493.0 + 200.0 : 2.0 * 350.0 + 320.0; }
 
 double list_entries_per_node(int dim) { return dim == 3 ? 56.0 : 21.0; }
 

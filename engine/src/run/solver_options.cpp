@@ -56,7 +56,7 @@ std::vector<SolverOption> make_table() {
                                                {"volume", NodeDiameter::Volume},
                                                {"section", NodeDiameter::Section},
                                                {"stretch", NodeDiameter::Stretch}}),
-                 "how a particle node's diameter follows the deformation (section = Eq. 3 as printed)", ""});
+                 "how a particle node's diameter follows the deformation (section = Eq. 3 as printed; stretch: 3D, the largest isochoric stretch)", ""});
     t.push_back({"weight", choice_of(&S::weight, {{"gpa", WeightKind::Gpa}, {"sph-nsf", WeightKind::SphNsf}}),
                  "variable-connectivity weight: GPA (Eq. 1b) or the SPH-NSF cubic spline (Eqs. 62-65)", ""});
     t.push_back({"normalisation",

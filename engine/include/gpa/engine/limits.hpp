@@ -27,7 +27,7 @@ std::string format_bytes(double bytes);
 // Memory of a run per node, besides its neighbour lists: the node store and the copy a
 // snapshot is written from, lattice-row offsets, search scratch, scatter plan, cell grid,
 // ghosts (docs/performance.md section 3: 2D about 350 bytes of node store and 320 of the rest;
-// 3D 445 and about 200).
+// 3D 445 and about 200, and since issue 23 the 48 bytes of a 3D node's B).
 double bytes_per_node_besides_lists(int dim);
 // Memory per candidate pair of the neighbour lists: the candidate index (4 bytes), its keep
 // flag (1) and its share of the cut lists (4).
