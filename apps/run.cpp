@@ -292,6 +292,13 @@ void print_report(const Simulation& sim) {
     }
     fmt::print("  plastic work {:.4g} J, viscous work {:.4g} J, boundary work {:.3g} J, energy error {:+.3g} %\n",
                t.plastic_work, t.viscous_work, t.boundary_work, 100.0 * t.energy_error);
+    for (std::size_t b = 0; b < sim.scene().bodies.size(); ++b) {
+        if (const int copies = symmetry_copies(sim.scene(), b); copies > 1) {
+            fmt::print("  body \"{}\" is 1/{} of the whole (symmetry planes): its energies and masses are the model's, its length "
+                       "and footprint the whole body's\n",
+                       sim.scene().bodies[b].name, copies);
+        }
+    }
     const int dim = sim.nodes().dim();
     for (const auto& r : t.regions) {
         std::string reaction;

@@ -477,7 +477,16 @@ std::string json_number(double v) { return std::isfinite(v) ? fmt::format("{:.10
 
 std::map<std::string, double> run_metrics(const Simulation& sim) {
     const auto& t = sim.totals();
-    std::map<std::string, double> m{{"plastic_work", t.plastic_work}};
+    // A half or quarter model's plastic work is that of its share of the body; the metric is the
+    // whole body's, as its length and footprint are (measure.hpp). Bodies cut into different
+    // shares have no whole-body figure: the metric is left out.
+    const Scene& scene = sim.scene();
+    int copies = scene.bodies.empty() ? 1 : symmetry_copies(scene, 0);
+    for (std::size_t b = 1; b < scene.bodies.size(); ++b) {
+        if (symmetry_copies(scene, b) != copies) copies = 0;
+    }
+    std::map<std::string, double> m;
+    if (copies > 0) m["plastic_work"] = copies * t.plastic_work;
     // Length and footprint are measured above the first rigid plane (measure.hpp): a scene without
     // one has no such metrics (its totals read 0, which no reference should be divided into).
     if (!t.planes.empty()) {
@@ -619,6 +628,9 @@ void write_summary(const fs::path& file, const Simulation& sim, const RunSummary
             "\"internal_energy_J\": {}, \"momentum_kg_m_s\": {}, \"centre_velocity_m_s\": {}",
             k ? ",\n    " : "", json_string(b.name), b.nodes, b.failed_nodes, json_number(b.mass), json_number(b.kinetic_energy),
             json_number(b.internal_energy), vec(b.momentum), vec(b.centre_velocity));
+        // A half or quarter model (symmetry planes cut or bound the body): its figures above are
+        // those of the model, one of `symmetry_copies` shares of the whole body.
+        if (k < scene.bodies.size()) bodies += fmt::format(", \"symmetry_copies\": {}", symmetry_copies(scene, k));
         if (b.measured) {
             bodies += fmt::format(", \"pieces\": {}, \"main_piece_mass_kg\": {}, \"residual_velocity_m_s\": {}, "
                                   "\"residual_speed_along_impact_m_s\": {}",
@@ -745,6 +757,14 @@ std::vector<std::pair<double, double>> final_outline(const Simulation& sim) {
     if (!axisymmetric) {
         for (std::size_t i = 0; i < count; ++i) {
             for (int c : across) centre[c] += n.position[c][i] / double(count);
+        }
+        // A half or quarter model: the whole body's centroid lies on the symmetry planes it reaches.
+        for (std::size_t k = 0; k < scene.planes.size(); ++k) {
+            for (std::size_t b = 0; b < scene.bodies.size(); ++b) {
+                if (scene.planes[k].axis != plane->axis && reaches_symmetry_plane(scene, b, k)) {
+                    centre[static_cast<std::size_t>(scene.planes[k].axis)] = scene.planes[k].position;
+                }
+            }
         }
     }
     double mean_d = 0.0;

@@ -64,10 +64,12 @@ HourglassPower hourglass_centre(std::span<const NodeIndex> row, std::size_t i, c
         no_kept_fit(f.stiffness_fit);
         return out;
     }
-    // The pairs the control acts on: a centre's real neighbours of its own body (ghosts and other
-    // bodies take no part, nor do the pairs of a failed node when those separate).
+    // The pairs the control acts on: a centre's neighbours of its own body, real or ghosts that
+    // continue the body across a symmetry plane (ghosts of rigid planes and of the axis, and other
+    // bodies, take no part, nor do the pairs of a failed node when those separate).
     const auto controlled_pair = [&](NodeIndex j) {
-        return j < real_count && f.body[j] == f.body[i] && !(f.failed && (f.failed[i] || f.failed[j]));
+        const bool continues = j < real_count || (f.ghost_continues && f.ghost_continues[j - real_count]);
+        return continues && f.body[j] == f.body[i] && !(f.failed && (f.failed[i] || f.failed[j]));
     };
     // The stiffness form acts on pairs of two fixed nodes: the lattice pairs, whose initial offsets
     // are the lattice's.

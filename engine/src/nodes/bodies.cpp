@@ -124,6 +124,31 @@ LatticeBlock body_lattice(const Scene& scene, std::size_t index) {
                 throw InputError(fmt::format("body \"{}\": a rectangle is a 2D shape; use a box in 3D", b.name));
         }
     }
+    // A symmetry plane through the body keeps the cells on its side (a half or quarter model). It
+    // must lie on a face of the body's cells: the ghost of a node s/2 from the plane is then s/2
+    // behind it, where the full body's lattice has its mirror node, and fixed lists continue across
+    // it (fill_lattice).
+    for (std::size_t k = 0; k < scene.planes.size(); ++k) {
+        if (!symmetry_plane_cuts(scene, index, k)) continue;
+        const PlaneSpec& plane = scene.planes[k];
+        const auto a = static_cast<std::size_t>(plane.axis);
+        const double cells = (plane.position - block.origin[a]) / block.spacing[a];
+        if (std::abs(cells - std::round(cells)) > 1e-6) {
+            const double below = block.origin[a] + std::floor(cells) * block.spacing[a];
+            const char* letter = dim == 2 ? (a == 0 ? "x" : "z") : (a == 0 ? "x" : a == 1 ? "y" : "z");
+            throw InputError(fmt::format(
+                "plane \"{}\" (plane[{}]) at {} = {} m cuts body \"{}\" between two faces of its lattice's cells ({} = {} m "
+                "and {} m): a symmetry plane through a body must lie on a cell face, so that its ghosts continue the "
+                "lattice; move the plane or the body's origin (a cylinder's or sphere's cell faces pass through its centre "
+                "in 3D; in 2D when it is an even number of cells across)",
+                plane.name, k, letter, plane.position, b.name, letter, below, below + block.spacing[a]));
+        }
+        const double position = plane.position;
+        const int side = plane.side;
+        block.inside = [inner = std::move(block.inside), a, position, side](const std::array<double, 3>& p) {
+            return side * (p[a] - position) > 0.0 && (!inner || inner(p));
+        };
+    }
     return block;
 }
 

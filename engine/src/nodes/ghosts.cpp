@@ -185,6 +185,12 @@ void GhostSet::update(NodeStore& nodes, std::size_t real_count) const {
                 nodes.position[a][g] = 2.0 * planes_[p].position - nodes.position[a][g];
                 nodes.velocity[a][g] = -nodes.velocity[a][g];
             }
+            for (int c = 0; c < dim; ++c) nodes.initial_position[c][g] = nodes.initial_position[c][s];
+            for (std::size_t p = 0; p < planes_.size(); ++p) {
+                if (!((mask_[k] >> p) & 1u)) continue;
+                const int a = planes_[p].axis;
+                nodes.initial_position[a][g] = 2.0 * planes_[p].position - nodes.initial_position[a][g];
+            }
             nodes.mass[g] = nodes.mass[s];
             nodes.volume[g] = nodes.volume[s];
             nodes.initial_volume[g] = nodes.initial_volume[s];
@@ -384,6 +390,40 @@ void GhostSet::append_ghost_rows(CompressedRows& lists, std::size_t real_count) 
             if (j < real_count) continue;
             const std::size_t t = static_cast<std::size_t>(target(s, j)) - real_count;
             lists.indices[next[t]++] = source_[j - real_count];
+        }
+    }
+}
+
+const std::uint8_t* GhostSet::continuing_flags() {
+    std::uint8_t planes = 0;
+    for (std::size_t p = 0; p < planes_.size(); ++p) {
+        if (planes_[p].continues_body) planes |= static_cast<std::uint8_t>(1u << p);
+    }
+    if (planes == 0) return nullptr;
+    continues_.resize(source_.size());
+    for (std::size_t k = 0; k < source_.size(); ++k) continues_[k] = (mask_[k] & ~planes) == 0 ? 1 : 0;
+    return continues_.data();
+}
+
+void GhostSet::save_forces(const NodeStore& nodes, std::size_t real_count) {
+    for (int c = 0; c < nodes.dim(); ++c) {
+        saved_force_[c].assign(nodes.force[c].begin() + static_cast<std::ptrdiff_t>(real_count),
+                               nodes.force[c].begin() + static_cast<std::ptrdiff_t>(real_count + source_.size()));
+    }
+}
+
+void GhostSet::fold_forces(NodeStore& nodes, std::size_t real_count) const {
+    const int dim = nodes.dim();
+    for (std::size_t k = 0; k < source_.size(); ++k) {
+        if (continues_.size() != source_.size() || !continues_[k]) continue;
+        const std::size_t g = real_count + k, s = source_[k];
+        for (int c = 0; c < dim; ++c) {
+            double change = nodes.force[c][g] - saved_force_[c][k];
+            for (std::size_t p = 0; p < planes_.size(); ++p) {
+                if (((mask_[k] >> p) & 1u) && planes_[p].axis == c) change = -change;
+            }
+            nodes.force[c][s] += change;
+            nodes.force[c][g] = saved_force_[c][k];
         }
     }
 }

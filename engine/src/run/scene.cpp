@@ -390,6 +390,22 @@ void check_plane(const Scene& scene, const PlaneSpec& p, std::size_t i) {
         const BodySpec& b = scene.bodies[k];
         const auto [lo, hi] = extent(b, g, p.axis);
         const double tolerance = 1e-9 * std::max(b.spacing, std::abs(p.position));
+        if (symmetry_plane_cuts(scene, k, i)) {
+            // A half or quarter model: the body is filled on the plane's side (body_lattice), and the
+            // plane's ghosts continue it across.
+            if (b.discretisation == Discretisation::Elements) {
+                fail(fmt::format("{} at {} = {} m cuts {}, which is discretised by elements: element bodies may touch a "
+                                 "symmetry plane but not be cut by it; give the element body's half or quarter as its shape",
+                                 label, letter, p.position, body_label(b, k)));
+            }
+            if (g == GeometryKind::Axisymmetric && p.axis == 0) {
+                fail(fmt::format("{} at x = {} m cuts {}: in an axisymmetric scene a plane normal to x is a cylinder "
+                                 "around the axis, not a plane of symmetry; only a plane normal to z may cut a body",
+                                 label, p.position, body_label(b, k)));
+            }
+            body_lattice(scene, k);  // throws when the plane does not lie on a cell face of the body's lattice
+            continue;
+        }
         if (p.side > 0 && lo < p.position - tolerance) {
             fail(fmt::format("{} at {} = {} m keeps bodies above it (side +1), but {} is on the wrong side: it reaches down "
                              "to {} = {} m",
@@ -732,6 +748,39 @@ double cylinder_radius_at(const BodySpec& b, double height) {
     return R;
 }
 
+
+bool symmetry_plane_cuts(const Scene& scene, std::size_t body, std::size_t plane) {
+    const int dim = dimension_of(scene.geometry);
+    if (body >= scene.bodies.size() || plane >= scene.planes.size()) return false;
+    const PlaneSpec& p = scene.planes[plane];
+    if (p.kind != PlaneKind::Symmetry || p.axis < 0 || p.axis >= dim || !finite(p.position)) return false;
+    const BodySpec& b = scene.bodies[body];
+    const auto [lo, hi] = extent(b, scene.geometry, p.axis);
+    const double tolerance = 1e-9 * std::max(b.spacing, std::abs(p.position));
+    return lo < p.position - tolerance && hi > p.position + tolerance;
+}
+
+bool reaches_symmetry_plane(const Scene& scene, std::size_t body, std::size_t plane) {
+    const int dim = dimension_of(scene.geometry);
+    if (body >= scene.bodies.size() || plane >= scene.planes.size()) return false;
+    const PlaneSpec& p = scene.planes[plane];
+    if (p.kind != PlaneKind::Symmetry || p.axis < 0 || p.axis >= dim || !finite(p.position)) return false;
+    const BodySpec& b = scene.bodies[body];
+    const auto [lo, hi] = extent(b, scene.geometry, p.axis);
+    const double tolerance = 1e-9 * std::max(b.spacing, std::abs(p.position));
+    return lo < p.position + tolerance && hi > p.position - tolerance;
+}
+
+int symmetry_copies(const Scene& scene, std::size_t body) {
+    int copies = 1, axes = 0;
+    for (std::size_t k = 0; k < scene.planes.size(); ++k) {
+        if (!reaches_symmetry_plane(scene, body, k) || (axes & (1 << scene.planes[k].axis))) continue;
+        axes |= 1 << scene.planes[k].axis;
+        copies *= 2;
+    }
+    return copies;
+}
+
 void validate_scene(const Scene& scene) {
     const GeometryKind g = scene.geometry;
     if (g != GeometryKind::Axisymmetric && g != GeometryKind::PlaneStrain && g != GeometryKind::ThreeD) {
@@ -758,6 +807,16 @@ void validate_scene(const Scene& scene) {
         }
     }
 
+    // Planes before overlaps: a symmetry plane that cuts a body changes the nodes it is filled with.
+    for (std::size_t i = 0; i < scene.planes.size(); ++i) {
+        check_plane(scene, scene.planes[i], i);
+        for (std::size_t j = 0; j < i; ++j) {
+            if (!scene.planes[i].name.empty() && scene.planes[j].name == scene.planes[i].name) {
+                fail(fmt::format("{}: the name is already used by plane[{}]", plane_label(scene.planes[i], i), j));
+            }
+        }
+    }
+
     for (std::size_t i = 0; i < scene.bodies.size(); ++i) {
         for (std::size_t j = i + 1; j < scene.bodies.size(); ++j) check_overlap(scene, i, j);
     }
@@ -777,14 +836,6 @@ void validate_scene(const Scene& scene) {
                          body_label(scene.bodies[e], e), body_label(scene.bodies[p], p)));
     }
 
-    for (std::size_t i = 0; i < scene.planes.size(); ++i) {
-        check_plane(scene, scene.planes[i], i);
-        for (std::size_t j = 0; j < i; ++j) {
-            if (!scene.planes[i].name.empty() && scene.planes[j].name == scene.planes[i].name) {
-                fail(fmt::format("{}: the name is already used by plane[{}]", plane_label(scene.planes[i], i), j));
-            }
-        }
-    }
 
     if (scene.prescribed_velocities.size() > 255) {
         fail(fmt::format("prescribed_velocity: {} regions, at most 255", scene.prescribed_velocities.size()));

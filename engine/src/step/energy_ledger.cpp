@@ -42,9 +42,11 @@ void EnergyLedger::keep_hourglass_fits(HourglassFields<D>& control, std::size_t 
     if (stiffness_) point(stiffness_fit_, control.stiffness_fit);
 }
 
-void EnergyLedger::keep_half_step_velocities(const NodeStore& nodes, std::size_t real) {
+void EnergyLedger::keep_half_step_velocities(const NodeStore& nodes) {
     if (!(compatible_ && hourglass_)) return;
-    for (int c = 0; c < nodes.dim(); ++c) half_velocity_[c].assign(nodes.velocity[c].begin(), nodes.velocity[c].begin() + real);
+    // Ghosts included (their mirrored velocities): the control pairs the ghosts that continue a body
+    // across a symmetry plane (hourglass.hpp, ghost_continues), and the booking reads them too.
+    for (int c = 0; c < nodes.dim(); ++c) half_velocity_[c].assign(nodes.velocity[c].begin(), nodes.velocity[c].end());
 }
 
 template <class G>

@@ -49,7 +49,7 @@ public:
 
     // Before the velocity update: v^{n+1/2} of the real nodes, from which the force pass made the
     // hourglass forces (their power is taken at the mean velocities later). Only when needed.
-    void keep_half_step_velocities(const NodeStore& nodes, std::size_t real);
+    void keep_half_step_velocities(const NodeStore& nodes);
 
     // After the velocity update and the prescribed components (compatible update only): the work of
     // each centre's stress forces and, with the hourglass control, of its control forces at the mean
@@ -91,7 +91,7 @@ private:
     std::vector<double> bond_power_, hourglass_power_, stiffness_power_;  // per node of the force pass
     std::vector<double> stress_power_, viscous_power_;                   // per real node
     std::array<std::vector<double>, 3> mean_velocity_;                    // per node, ghosts mirrored
-    std::array<std::vector<double>, 3> half_velocity_;                    // per real node
+    std::array<std::vector<double>, 3> half_velocity_;                    // per node, ghosts included
     // The force pass's hourglass fits per real node: the scale, then the D * D matrix entries.
     std::array<std::vector<double>, 10> damping_fit_, stiffness_fit_;
 };

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <span>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_reduce.h>
@@ -14,18 +15,27 @@ namespace gpa {
 namespace {
 
 // Node i into the extent above `plane` (measure.hpp): across the plane's first other axis (the
-// radius x in axisymmetric geometry) in 2D, along the footprint's directions in the plane in 3D.
+// radius x in axisymmetric geometry) in 2D, along the footprint's directions in the plane in 3D;
+// with its images across the symmetry planes in `mirrors` that stand on `plane` (normal to another
+// axis, at most one per axis), so that a half or quarter model is measured as the whole body.
 void add_to_extent(measure::Extent& e, const NodeStore& nodes, std::size_t i, const GhostPlane& plane, bool axisymmetric,
-                   double base) {
+                   double base, std::span<const GhostPlane> mirrors) {
     const int d = nodes.dim();
     const double height = plane.distance(nodes.position[plane.axis][i]) - base;
     const double cell = measure::particle_cell_size(nodes.size_weight[i], d);
     const int first = plane.axis == 0 ? 1 : 0;
-    if (d == 3) {
-        const int second = plane.axis == 2 ? 1 : 2;
-        measure::add_particle_3d(e, height, nodes.position[first][i], nodes.position[second][i], cell);
-    } else {
-        measure::add_particle(e, height, nodes.position[first][i], cell, axisymmetric && first == 0);
+    const int second = plane.axis == 2 ? 1 : 2;  // 3D only
+    const std::size_t images = std::size_t{1} << mirrors.size();
+    for (std::size_t mask = 0; mask < images; ++mask) {
+        std::array<double, 3> x{nodes.position[0][i], nodes.position[1][i], d == 3 ? nodes.position[2][i] : 0.0};
+        for (std::size_t k = 0; k < mirrors.size(); ++k) {
+            if (mask & (std::size_t{1} << k)) x[mirrors[k].axis] = 2.0 * mirrors[k].position - x[mirrors[k].axis];
+        }
+        if (d == 3) {
+            measure::add_particle_3d(e, height, x[first], x[second], cell);
+        } else {
+            measure::add_particle(e, height, x[first], cell, axisymmetric && first == 0);
+        }
     }
 }
 
@@ -48,6 +58,31 @@ void Measures::set_up(const Scene& scene, const NodeStore& nodes, std::size_t re
     for (const auto& b : scene.bodies) body_velocity.push_back(b.velocity);
     impact_ = impact_frame(nodes, real, body_velocity, scene.geometry == GeometryKind::Axisymmetric);
     body_kinetic_half_.assign(scene.bodies.size(), 0.0);
+    // The symmetry planes a particle body reaches (scene.hpp, reaches_symmetry_plane); not in
+    // axisymmetric geometry, whose widths are mirrored about the axis already.
+    width_mirrors_.clear();
+    if (scene.geometry == GeometryKind::Axisymmetric) return;
+    for (std::size_t k = 0; k < scene.planes.size(); ++k) {
+        const PlaneSpec& p = scene.planes[k];
+        for (std::size_t b = 0; b < scene.bodies.size(); ++b) {
+            if (scene.bodies[b].discretisation == Discretisation::Particles && reaches_symmetry_plane(scene, b, k)) {
+                width_mirrors_.push_back({p.name, p.axis, p.position, p.side, false, false});
+                break;
+            }
+        }
+    }
+}
+
+std::vector<GhostPlane> Measures::mirrors_on(const GhostPlane& plane) const {
+    std::vector<GhostPlane> out;
+    int axes = 0;
+    for (const GhostPlane& m : width_mirrors_) {
+        // One plane per axis: two parallel symmetry planes would make an endless row of images.
+        if (m.axis == plane.axis || (axes & (1 << m.axis))) continue;
+        axes |= 1 << m.axis;
+        out.push_back(m);
+    }
+    return out;
 }
 
 double Measures::advance_kinetic(double half_step_now) {
@@ -58,6 +93,7 @@ double Measures::advance_kinetic(double half_step_now) {
 
 NodeSums Measures::node_sums(const NodeStore& nodes, std::size_t real, const GhostPlane* plane, bool axisymmetric) const {
     const int d = nodes.dim();
+    const std::vector<GhostPlane> mirrors = plane ? mirrors_on(*plane) : std::vector<GhostPlane>{};
     return tbb::parallel_deterministic_reduce(
         tbb::blocked_range<std::size_t>(0, real, reduce_grain), NodeSums{},
         [&](const tbb::blocked_range<std::size_t>& r, NodeSums acc) {
@@ -74,7 +110,7 @@ NodeSums Measures::node_sums(const NodeStore& nodes, std::size_t real, const Gho
                 acc.viscous += m * nodes.viscous_work[i];
                 acc.variable += nodes.connectivity[i] == Connectivity::Variable;
                 acc.failed += nodes.failed[i] != 0;
-                if (plane) add_to_extent(acc.extent, nodes, i, *plane, axisymmetric, 0.0);
+                if (plane) add_to_extent(acc.extent, nodes, i, *plane, axisymmetric, 0.0, mirrors);
             }
             return acc;
         },
@@ -83,10 +119,11 @@ NodeSums Measures::node_sums(const NodeStore& nodes, std::size_t real, const Gho
 
 measure::Extent Measures::particle_extent(const NodeStore& nodes, std::size_t real, const GhostPlane& plane, bool axisymmetric,
                                           double base) const {
+    const std::vector<GhostPlane> mirrors = mirrors_on(plane);
     return tbb::parallel_deterministic_reduce(
         tbb::blocked_range<std::size_t>(0, real, reduce_grain), measure::Extent{},
         [&](const tbb::blocked_range<std::size_t>& r, measure::Extent acc) {
-            for (std::size_t i = r.begin(); i != r.end(); ++i) add_to_extent(acc, nodes, i, plane, axisymmetric, base);
+            for (std::size_t i = r.begin(); i != r.end(); ++i) add_to_extent(acc, nodes, i, plane, axisymmetric, base, mirrors);
             return acc;
         },
         [](measure::Extent x, const measure::Extent& y) { return x += y; });
@@ -249,6 +286,35 @@ void Measures::local_fields(const Scene& scene, const NodeStore& nodes, std::siz
                         face_value.push_back(m.points.plastic_strain[t]);
                     }
                 }
+            }
+        }
+    }
+    // A half or quarter model: the points' images across the symmetry planes bodies reach belong to
+    // the neighbourhoods too (a point next to the plane has its mirror neighbours in the whole
+    // body). The images follow the points, so a tie still goes to the real point.
+    GhostPlane no_plane;
+    no_plane.axis = -1;
+    const std::vector<GhostPlane> mirrors = mirrors_on(plane ? *plane : no_plane);
+    if (!mirrors.empty()) {
+        const std::size_t points = strain.size(), face = face_across.size();
+        for (std::size_t mask = 1; mask < (std::size_t{1} << mirrors.size()); ++mask) {
+            const auto image = [&](std::array<double, 3> x) {
+                for (std::size_t k = 0; k < mirrors.size(); ++k) {
+                    if (mask & (std::size_t{1} << k)) x[mirrors[k].axis] = 2.0 * mirrors[k].position - x[mirrors[k].axis];
+                }
+                return x;
+            };
+            for (std::size_t q = 0; q < points; ++q) {
+                measure::FieldPoint s = strain[q], t = heat[q];
+                s.position = t.position = image(strain[q].position);
+                strain.push_back(s);
+                heat.push_back(t);
+            }
+            for (std::size_t q = 0; q < face; ++q) {
+                std::array<double, 3> x{0, 0, 0};
+                x[static_cast<std::size_t>(across)] = face_across[q];
+                face_across.push_back(image(x)[static_cast<std::size_t>(across)]);
+                face_value.push_back(face_value[q]);
             }
         }
     }

@@ -69,6 +69,11 @@ public:
     void read_state(StateReader& in, std::size_t bodies);
 
 private:
+    // The symmetry planes bodies reach (set_up), and of them those that stand on `plane`, one per
+    // axis: a node's images across them belong to the body's extent (measure.hpp).
+    std::vector<GhostPlane> mirrors_on(const GhostPlane& plane) const;
+
+    std::vector<GhostPlane> width_mirrors_;
     ImpactFrame impact_;
     double kinetic_half_ = 0.0;              // kinetic energy of the current half-step velocities
     std::vector<double> body_kinetic_half_;  // per body, the same

@@ -148,7 +148,7 @@ void Simulation::Impl::setup() {
             friction.push_back({p.friction_static, p.friction_dynamic});
         }
         planes.push_back({p.name, p.axis, p.position, p.side, p.kind == PlaneKind::Rigid && p.lift_off,
-                          p.kind == PlaneKind::Rigid});
+                          p.kind == PlaneKind::Rigid, p.kind == PlaneKind::Symmetry});
     }
     ghosts = GhostSet(planes);
     rigid_planes.assign(std::move(rigid), std::move(friction));
@@ -378,7 +378,9 @@ void Simulation::Impl::forces() {
     if (ledger.hourglass()) {
         auto control = hourglass_control_fields<G>(ledger.hourglass_power(nodes.size()), ledger.stiffness_power(nodes.size()));
         ledger.keep_hourglass_fits<G::dim>(control, real);
+        if (control.ghost_continues) ghosts.save_forces(nodes, real);
         apply_hourglass_control<G::dim>(lists(), plan(), control, real, scene.solver.hourglass_coefficient);
+        if (control.ghost_continues) ghosts.fold_forces(nodes, real);  // a half or quarter model (ghosts.hpp)
     }
     rigid_planes.take_reactions(ghosts, nodes, real);
 }
@@ -390,6 +392,7 @@ HourglassFields<G::dim> Simulation::Impl::hourglass_control_fields(double* power
     auto h = hourglass_fields<G::dim>(nodes, scene.solver.switch_plastic_strain, power, scene.solver.hourglass_stiffness,
                                       stiffness_power);
     if (contact.sliding() && contact.failed_pairs_separate()) h.failed = nodes.failed.data();
+    h.ghost_continues = ghosts.continuing_flags();
     return h;
 }
 
@@ -404,7 +407,7 @@ void Simulation::Impl::integrate(double dt_avg) {
                                           d == 3 ? nodes.velocity[2].data() : nullptr};
     HeldNodes& held = regions.particles();
     if (!held.empty()) held.capture({velocity[0], velocity[1], velocity[2]}, d);
-    ledger.keep_half_step_velocities(nodes, real);
+    ledger.keep_half_step_velocities(nodes);
     rigid_planes.apply_friction(ghosts, nodes, real, dt_avg);  // Coulomb friction joins the forces
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, real, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
         for (int c = 0; c < d; ++c) {

@@ -25,6 +25,10 @@ struct GhostPlane {
     int side = +1;          // the real nodes lie above (+1) or below (-1) the plane along `axis`
     bool lift_off = false;  // pairs with its ghosts may only push (a rigid plane with lift-off)
     bool rigid = false;     // a rigid wall (its reaction is reported) rather than a symmetry plane
+    // A symmetry plane of the scene: its ghosts continue the bodies (a half or quarter model), and
+    // the hourglass control pairs them like real nodes (continuing_flags). Not the axis of an
+    // axisymmetric scene, whose ghosts stay out of the control as they always have.
+    bool continues_body = false;
 
     // Signed distance of a point's coordinate from the plane, positive on the real side.
     double distance(double coordinate) const { return side * (coordinate - position); }
@@ -120,6 +124,19 @@ public:
     // that each real-ghost pair has its mirror image.
     void append_ghost_rows(CompressedRows& lists, std::size_t real_count) const;
 
+    // Per ghost of the last build, 1 where every plane of its mask continues the bodies (a
+    // symmetry plane of the scene: GhostPlane::continues_body), for HourglassFields::ghost_continues;
+    // null when no ghost does.
+    const std::uint8_t* continuing_flags();
+
+    // The hourglass control's forces on the continuing ghosts, moved to their sources: save_forces
+    // keeps the ghosts' forces before the control, fold_forces moves what the control added to each
+    // continuing ghost to its source, mirrored across the ghost's planes (a force on the mirror of
+    // node s is the mirror of a force on s: the whole body's centre across the plane acts on s),
+    // and gives the ghost back its saved force. In ghost order, one order on any thread count.
+    void save_forces(const NodeStore& nodes, std::size_t real_count);
+    void fold_forces(NodeStore& nodes, std::size_t real_count) const;
+
     std::size_t count() const { return source_.size(); }
     NodeIndex source(std::size_t ghost) const { return source_[ghost]; }
     std::uint8_t planes_of(std::size_t ghost) const { return mask_[ghost]; }
@@ -138,6 +155,8 @@ public:
     void memory_use(MemoryUse& out) const;
 
 private:
+    std::vector<std::uint8_t> continues_;                // continuing_flags()
+    std::array<std::vector<double>, 3> saved_force_;     // save_forces(), per ghost
     std::vector<GhostPlane> planes_;
     std::vector<std::uint8_t> masks_;            // the corner combinations in use: distinct axes
     std::vector<std::vector<std::int32_t>> index_;  // per mask slot, per real node: ghost node or -1

@@ -29,6 +29,12 @@ struct HourglassFields {
     // Set when the pairs of failed nodes separate (separation.hpp): a crack is no pair of the
     // control (its faces slide freely, spec section 2 "[spec] Sliding contact").
     const std::uint8_t* failed = nullptr;
+    // Per ghost (index j - real_count), 1 where the ghost continues the body across symmetry planes
+    // (a half or quarter model): its pairs are controlled like those of the real node it mirrors, so
+    // that a centre next to the plane is fitted over the neighbourhood it has in the whole body. The
+    // forces such pairs put on a ghost belong to its source, mirrored (the caller folds them back:
+    // GhostSet::fold_forces). Null, and for ghosts of a rigid plane or the axis: no part.
+    const std::uint8_t* ghost_continues = nullptr;
     const double* plastic_strain = nullptr;
     // Variable-connectivity centres are controlled while their equivalent plastic strain is below
     // this (the lattice regime, where the mode lives: see apply_hourglass_control); fixed ones always.

@@ -31,8 +31,10 @@
 // in spokes along the lattice's rows). Its spans are kept along `footprint_directions` directions
 // u_k = cos(theta_k) e1 + sin(theta_k) e2, theta_k = k pi / K, k = 0 .. K - 1, in the plane's other
 // two axes (e1 before e2): a particle's span along u_k is [u_k . p - d/2, u_k . p + d/2] (its cell
-// reaches d/2 every way); element bodies are 2D only. A 3D body cut by symmetry planes (a quarter
-// model) is measured as it is, not mirrored: its footprint is the quarter's width. The footprint is the mean of the
+// reaches d/2 every way); element bodies are 2D only. A half or quarter model (a body that symmetry
+// planes normal to the plane's other axes cut or bound) is measured as the whole body: each node
+// counts with its images across those planes (Measures, step/measures.cpp), in 2D and 3D, and so do
+// the points of the local peaks below. The footprint is the mean of the
 // K widths (the mean width of a convex outline; pi D for its perimeter); footprint_narrowest and
 // footprint_widest give their spread.
 

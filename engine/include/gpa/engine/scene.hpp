@@ -312,6 +312,22 @@ public:
 
 void validate_scene(const Scene& scene);
 
+// Whether scene.planes[plane] is a symmetry plane that passes through scene.bodies[body] (the
+// body's shape reaches beyond it on both sides; touching is not cutting). Such a body is filled on
+// the plane's side only and the plane's ghosts continue it across: a half model, or a quarter one
+// with two such planes (docs/scene-format.md). False for a plane that is not valid.
+bool symmetry_plane_cuts(const Scene& scene, std::size_t body, std::size_t plane);
+
+// Whether body `body` reaches symmetry plane `plane`: the plane cuts it or the body touches it. The
+// model is then half of a body mirrored across the plane, and the body's widths are measured with
+// its mirror image (measure.hpp).
+bool reaches_symmetry_plane(const Scene& scene, std::size_t body, std::size_t plane);
+
+// How many copies of body `body` the symmetry planes it reaches make of the whole: 2 to the number
+// of such planes with distinct normals (1 without any, 2 a half model, 4 a quarter). The model's
+// masses, energies and momenta are those of one copy; its widths are measured on the whole.
+int symmetry_copies(const Scene& scene, std::size_t body);
+
 // Values a valid scene may hold but an impact simulation hardly ever does, most often a unit
 // slip ("190 km/s" for 190 m/s, "10 m" for 10 mm): a body faster than 20 km/s (light-gas guns
 // reach about 10 km/s, orbital debris 15 km/s), a body smaller than 10 um or larger than 10 m
