@@ -98,6 +98,11 @@ void RigidPlanes::add_impulses(double dt_avg) {
 void RigidPlanes::guard_penetration(const GhostSet& ghosts, NodeStore& nodes, std::size_t real, EnergyLedger& ledger) {
     for (std::size_t p = 0; p < ghosts.planes().size(); ++p) {
         const auto& plane = ghosts.planes()[p];
+        // A symmetry plane of the scene is no wall: a node that crosses it is, in the whole body,
+        // one of two mirror nodes passing each other, and its ghost takes its place on this side
+        // (a half or quarter model stays the whole body's run). The axis of an axisymmetric scene
+        // stays guarded: a ring cannot have a negative radius.
+        if (plane.continues_body) continue;
         const auto rigid = std::find(ghost_plane_.begin(), ghost_plane_.end(), p);
         using WorkAndImpulse = std::array<double, 2>;
         const WorkAndImpulse lost = tbb::parallel_deterministic_reduce(

@@ -52,8 +52,9 @@ public:
     void book_friction(NodeStore& nodes, double dt_avg);
 
     // Spec section 7, the penetration guard, after the position update: a real node that ends
-    // behind a plane is put back just in front of it (by 1 % of its initial diameter) and loses its
-    // velocity towards the plane. The kinetic energy taken is booked in the ledger as boundary work,
+    // behind a rigid plane or the axis is put back just in front of it (by 1 % of its initial
+    // diameter) and loses its velocity towards the plane (not behind a symmetry plane of the scene:
+    // see the definition). The kinetic energy taken is booked in the ledger as boundary work,
     // plane by plane; the momentum taken is the rigid plane's impulse. Sums in a fixed order: nothing
     // depends on the thread count.
     void guard_penetration(const GhostSet& ghosts, NodeStore& nodes, std::size_t real, EnergyLedger& ledger);
