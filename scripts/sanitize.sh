@@ -22,7 +22,7 @@ mkdir -p "$build"
 cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_FLAGS_RELEASE="-O1 -gline-tables-only" \
   -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ \
   -DCMAKE_CXX_FLAGS="$flags" -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined" \
-  -DGPA_BUILD_BENCHMARKS=OFF -DGPA_BUILD_SLOW_TESTS=OFF -DGPA_BUILD_TOOLS=OFF -DGPA_BUILD_FUZZERS=ON \
+  -DGPA_BUILD_BENCHMARKS=OFF -DGPA_BUILD_SLOW_TESTS=OFF -DGPA_BUILD_TOOLS=OFF -DGPA_BUILD_FUZZERS=ON -DGPA_UNITY_BUILD=ON \
   > "$build/configure.log" || { cat "$build/configure.log"; exit 1; }
 cmake --build "$build" -j"$jobs"
 

@@ -39,7 +39,7 @@ std::vector<ForceCase> setups() {
     return out;
 }
 
-constexpr double a = 1.2;  // influence distance; not 1 so that nothing lines up by accident
+constexpr double influence = 1.2;  // influence distance; not 1 so that nothing lines up by accident
 
 NodeStore random_body(const ForceCase& s) {
     testing::LatticeOptions o;
@@ -75,11 +75,11 @@ struct Evaluated {
 template <class G>
 Evaluated<G> evaluate(const ForceCase& s, const BondViscosityParameters* bond, bool full_normalisation = false) {
     Evaluated<G> e{random_body(s), {}, {}};
-    e.lists = find_neighbours(e.nodes, a, e.nodes.size());
-    auto g = gradient_fields<G::dim>(e.nodes, a);
+    e.lists = find_neighbours(e.nodes, influence, e.nodes.size());
+    auto g = gradient_fields<G::dim>(e.nodes, influence);
     g.full_normalisation = full_normalisation;
     compute_velocity_gradient<G>(e.lists, s.weight, g);
-    auto f = force_fields<G::dim>(e.nodes, a);
+    auto f = force_fields<G::dim>(e.nodes, influence);
     f.full_normalisation = full_normalisation;
     e.bond_power.assign(e.nodes.size(), 0.0);
     f.bond_viscous_power = e.bond_power.data();
@@ -187,7 +187,7 @@ void check_energy(const ForceCase& s, const BondViscosityParameters* bond, bool 
                     }
                 }
                 al_dv = (N * l).dot(dv);
-                const double h = a * 0.5 * (n.diameter[i] + n.diameter[j]);
+                const double h = influence * 0.5 * (n.diameter[i] + n.diameter[j]);
                 // Lattice pairs (fixed centre and neighbour) weigh R(min(r/h, 1.8)) (spec section 2,
                 // lattice weights), all others R(r/h).
                 const bool lattice = s.connectivity == Connectivity::Fixed && n.connectivity[j] == Connectivity::Fixed;
@@ -251,7 +251,7 @@ void check_stress_power(const ForceCase& s, bool full_normalisation = false) {
         wp[c] = w[c].data();
     }
     std::vector<double> power(n.size()), viscous(n.size());
-    auto f = force_fields<D>(n, a);
+    auto f = force_fields<D>(n, influence);
     f.full_normalisation = full_normalisation;
     compute_stress_power<G>(e.lists, s.weight, f, wp, n.size(), power.data(), viscous.data());
     double sum = 0.0, force_power = 0.0, scale = 0.0;
@@ -265,7 +265,7 @@ void check_stress_power(const ForceCase& s, bool full_normalisation = false) {
     EXPECT_NEAR(sum, force_power, 1e-12 * scale) << name(s);
     // The viscous part from the velocity gradient of w (the gradient kernel, not the power kernel).
     for (int c = 0; c < D; ++c) std::copy(w[c].begin(), w[c].end(), n.velocity[c].begin());
-    auto g = gradient_fields<D>(n, a);
+    auto g = gradient_fields<D>(n, influence);
     g.full_normalisation = full_normalisation;
     compute_velocity_gradient<G>(e.lists, s.weight, g);
     for (std::size_t i = 0; i < n.size(); ++i) {

@@ -21,7 +21,7 @@
 namespace gpa {
 namespace {
 
-constexpr double spacing = 1e-3;
+constexpr double lattice_spacing = 1e-3;
 constexpr int cells = 14;
 
 // A plane-strain lattice whose lower half is fixed and upper half variable, as an automatic body
@@ -31,15 +31,15 @@ NodeStore half_switched(double jitter, double reach = 0.0) {
     testing::LatticeOptions o;
     o.geometry = GeometryKind::PlaneStrain;
     o.cells = cells;
-    o.spacing = spacing;
+    o.spacing = lattice_spacing;
     o.connectivity = Connectivity::Fixed;
     o.density = 7800.0;
     o.stencil_reach = reach;
     NodeStore nodes = testing::make_lattice(o);
     for (std::size_t i = 0; i < nodes.size(); ++i) {
-        if (nodes.position[1][i] > 0.5 * cells * spacing) nodes.connectivity[i] = Connectivity::Variable;
+        if (nodes.position[1][i] > 0.5 * cells * lattice_spacing) nodes.connectivity[i] = Connectivity::Variable;
     }
-    if (jitter > 0.0) testing::jitter(nodes, jitter, spacing, 17);
+    if (jitter > 0.0) testing::jitter(nodes, jitter, lattice_spacing, 17);
     return nodes;
 }
 
@@ -70,14 +70,14 @@ void expect_no_force_across_the_front(WeightKind weight, double a, double reach,
     compute_forces<PlaneStrain>(lists, make_slab_plan(lists, x), weight, nullptr, f, nodes.size());
     testing::LatticeOptions o;
     o.cells = cells;
-    o.spacing = spacing;
-    const double scale = 5e8 * spacing;  // pressure times the face of a node (unit thickness)
+    o.spacing = lattice_spacing;
+    const double scale = 5e8 * lattice_spacing;  // pressure times the face of a node (unit thickness)
     std::size_t checked = 0, at_front = 0;
     double worst = 0.0;
     for (std::size_t i = 0; i < nodes.size(); ++i) {
-        if (testing::distance_to_boundary(nodes, o, i) < margin * spacing) continue;
+        if (testing::distance_to_boundary(nodes, o, i) < margin * lattice_spacing) continue;
         ++checked;
-        at_front += std::abs(nodes.position[1][i] - 0.5 * cells * spacing) < 1.6 * spacing;
+        at_front += std::abs(nodes.position[1][i] - 0.5 * cells * lattice_spacing) < 1.6 * lattice_spacing;
         for (int c = 0; c < 2; ++c) worst = std::max(worst, std::abs(nodes.force[c][i]));
         if (!largest) {
             for (int c = 0; c < 2; ++c) EXPECT_NEAR(nodes.force[c][i], 0.0, 1e-12 * scale) << "node " << i << " component " << c;
@@ -133,7 +133,7 @@ TEST(LatticeCells, RatioIsOneUndeformedDetFUnderUniformDeformationAndNegativeWhe
         testing::LatticeOptions o;
         o.geometry = geometry;
         o.cells = 6;
-        o.spacing = spacing;
+        o.spacing = lattice_spacing;
         o.connectivity = Connectivity::Fixed;
         NodeStore nodes = testing::make_lattice(o);
         std::vector<double> ratio;
@@ -155,10 +155,10 @@ TEST(LatticeCells, RatioIsOneUndeformedDetFUnderUniformDeformationAndNegativeWhe
         // Push one interior node beyond its +x neighbour: its cells invert.
         std::size_t centre = 0;
         for (std::size_t i = 0; i < nodes.size(); ++i) {
-            if (testing::distance_to_boundary(nodes, o, i) > 2.0 * spacing) centre = i;
+            if (testing::distance_to_boundary(nodes, o, i) > 2.0 * lattice_spacing) centre = i;
         }
         NodeStore crushed = nodes;
-        crushed.position[0][centre] += 1.5 * spacing;
+        crushed.position[0][centre] += 1.5 * lattice_spacing;
         smallest_lattice_cell_ratios(crushed, crushed.size(), ratio);
         EXPECT_LT(ratio[centre], 0.0) << name_of(geometry);
         EXPECT_LE(std::count_if(ratio.begin(), ratio.end(), [](double r) { return r <= collapsed_cell_ratio; }),

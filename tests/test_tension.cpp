@@ -28,17 +28,17 @@
 namespace gpa {
 namespace {
 
-constexpr double spacing = 1e-3, sound_speed = 5000.0, stiffness = 0.05;
+constexpr double lattice_spacing = 1e-3, wave_speed = 5000.0, stiffness_coefficient = 0.05;
 
 NodeStore fixed_lattice(GeometryKind g) {
     testing::LatticeOptions o;
     o.geometry = g;
     o.cells = g == GeometryKind::ThreeD ? 5 : 8;
-    o.spacing = spacing;
+    o.spacing = lattice_spacing;
     o.connectivity = Connectivity::Fixed;
     o.density = 7800.0;
     NodeStore nodes = testing::make_lattice(o);
-    for (auto& s : nodes.sound_speed) s = sound_speed;
+    for (auto& s : nodes.sound_speed) s = wave_speed;
     return nodes;
 }
 
@@ -61,10 +61,10 @@ Stiffness stiffness_forces(NodeStore& nodes, const CompressedRows& lists, int th
     ThreadScope scope(threads);
     scope.run([&] {
         if (dim == 2) {
-            apply_hourglass_control<2>(lists, plan, hourglass_fields<2>(nodes, 0.1, damping.data(), stiffness, out.power.data()),
+            apply_hourglass_control<2>(lists, plan, hourglass_fields<2>(nodes, 0.1, damping.data(), stiffness_coefficient, out.power.data()),
                                        nodes.size(), 0.0);
         } else {
-            apply_hourglass_control<3>(lists, plan, hourglass_fields<3>(nodes, 0.1, damping.data(), stiffness, out.power.data()),
+            apply_hourglass_control<3>(lists, plan, hourglass_fields<3>(nodes, 0.1, damping.data(), stiffness_coefficient, out.power.data()),
                                        nodes.size(), 0.0);
         }
     });
@@ -105,7 +105,7 @@ double potential(const NodeStore& n, const CompressedRows& lists) {
             }
             sum += (x - map * X).squaredNorm() / X.squaredNorm();
         }
-        const double k = stiffness * n.mass[i] * sound_speed * sound_speed / (n.initial_diameter[i] * n.initial_diameter[i]);
+        const double k = stiffness_coefficient * n.mass[i] * wave_speed * wave_speed / (n.initial_diameter[i] * n.initial_diameter[i]);
         total += 0.5 * k * sum / weight;
     }
     return total;
@@ -148,7 +148,7 @@ TEST_P(HourglassStiffness, EveryAffineMapOfTheLatticeFeelsNothing) {
     const double affine = largest(stiffness_forces(nodes, lists));
     NodeStore noisy = fixed_lattice(g);
     std::mt19937_64 rng(3);
-    std::uniform_real_distribution<double> u(-0.1 * spacing, 0.1 * spacing);
+    std::uniform_real_distribution<double> u(-0.1 * lattice_spacing, 0.1 * lattice_spacing);
     for (int p = 0; p < dim; ++p) {
         for (auto& x : noisy.position[p]) x += u(rng);
     }
@@ -167,10 +167,10 @@ TEST_P(HourglassStiffness, PushesBackOnTheOddEvenDisplacementAndConservesMomentu
     NodeStore nodes = fixed_lattice(g);
     const auto lists = find_neighbours(nodes, 1.0, nodes.size());
     const int dim = nodes.dim(), vertical = dim - 1;
-    const double delta = 0.1 * spacing;
+    const double delta = 0.1 * lattice_spacing;
     std::vector<double> moved(nodes.size());
     for (std::size_t i = 0; i < nodes.size(); ++i) {
-        const auto row = static_cast<long>(std::floor(nodes.initial_position[vertical][i] / spacing));
+        const auto row = static_cast<long>(std::floor(nodes.initial_position[vertical][i] / lattice_spacing));
         moved[i] = row % 2 == 0 ? delta : -delta;
         nodes.position[vertical][i] += moved[i];
     }
@@ -178,7 +178,7 @@ TEST_P(HourglassStiffness, PushesBackOnTheOddEvenDisplacementAndConservesMomentu
     std::size_t interior = 0;
     for (std::size_t i = 0; i < nodes.size(); ++i) {
         const double z = nodes.initial_position[vertical][i];
-        if (z < 1.5 * spacing || z > 6.5 * spacing) continue;  // rows with a row on each side
+        if (z < 1.5 * lattice_spacing || z > 6.5 * lattice_spacing) continue;  // rows with a row on each side
         ++interior;
         EXPECT_LT(s.force[i][vertical] * moved[i], 0.0) << name_of(g) << " node " << i;
     }
@@ -206,7 +206,7 @@ TEST_P(HourglassStiffness, IsTheGradientOfItsPotential) {
     std::uniform_real_distribution<double> u(-1.0, 1.0);
     for (int p = 0; p < dim; ++p) {
         for (std::size_t i = 0; i < nodes.size(); ++i) {
-            nodes.position[p][i] += 0.15 * spacing * u(rng);
+            nodes.position[p][i] += 0.15 * lattice_spacing * u(rng);
             nodes.velocity[p][i] = 10.0 * u(rng);
         }
     }

@@ -21,7 +21,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+constexpr double no_value = std::numeric_limits<double>::quiet_NaN();
 
 // The settled rule's bound: the three finest values within 2 % of the finest.
 constexpr double settled_spread = 0.02;
@@ -59,7 +59,7 @@ double radius_at(const std::vector<std::pair<double, double>>& o, double z) {
         const auto [z1, r1] = o[k + 1];
         if (z >= z0 && z <= z1) return z1 > z0 ? r0 + (r1 - r0) * (z - z0) / (z1 - z0) : std::max(r0, r1);
     }
-    return nan;
+    return no_value;
 }
 
 }  // namespace
@@ -96,7 +96,7 @@ ElementReference reference_from_study(const StudyReport& report, const StudyAnal
         ReferenceValue v;
         for (const auto* c : cases) {
             const auto it = c->metrics.find(key);
-            v.values.push_back(it != c->metrics.end() ? it->second : nan);
+            v.values.push_back(it != c->metrics.end() ? it->second : no_value);
         }
         const std::size_t n = v.values.size();
         const double f1 = v.values[n - 3], f2 = v.values[n - 2], f3 = v.values[n - 1];
@@ -229,7 +229,7 @@ ElementReference read_element_reference(const fs::path& file) {
 }
 
 double outline_distance(const std::vector<std::pair<double, double>>& a, const std::vector<std::pair<double, double>>& b) {
-    if (a.size() < 2 || b.size() < 2) return nan;
+    if (a.size() < 2 || b.size() < 2) return no_value;
     auto sorted = [](std::vector<std::pair<double, double>> o) {
         std::stable_sort(o.begin(), o.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
         return o;
@@ -238,7 +238,7 @@ double outline_distance(const std::vector<std::pair<double, double>>& a, const s
     const double lo = std::max(sa.front().first, sb.front().first);
     const double top = std::min(sa.back().first, sb.back().first);
     const double hi = lo + 0.98 * (top - lo);
-    if (!(hi > lo)) return nan;
+    if (!(hi > lo)) return no_value;
     constexpr int samples = 200;
     double sum = 0.0;
     int counted = 0;
@@ -249,7 +249,7 @@ double outline_distance(const std::vector<std::pair<double, double>>& a, const s
         sum += std::abs(ra - rb);
         ++counted;
     }
-    return counted ? sum / counted : nan;
+    return counted ? sum / counted : no_value;
 }
 
 std::map<std::string, double> compare_with_reference(const std::map<std::string, double>& metrics,

@@ -18,7 +18,7 @@ using test::pure_shear;
 using test::von_mises;
 
 // Exact formulas evaluated in a handful of flops: agreement to a few ulp, 1e-12 relative.
-constexpr double kRoundOff = 1e-12;
+constexpr double kFailureRoundOff = 1e-12;
 
 // materials.md, Johnson-Cook fracture constants.
 const JohnsonCookFailure kCopperFracture{0.54, 4.89, -3.03, 0.014, 1.12, 1.0, 0.01};
@@ -37,7 +37,7 @@ TEST(JohnsonCookFailureStrain, MatchesClosedForm) {
             for (double t_star : {0.0, 0.4}) {
                 const double expected = eps_f_closed_form(kCopperFracture, sigma_star, rate, t_star);
                 EXPECT_NEAR(johnson_cook_failure_strain(kCopperFracture, sigma_star, rate, t_star), expected,
-                            kRoundOff * expected);
+                            kFailureRoundOff * expected);
             }
         }
     }
@@ -105,7 +105,7 @@ TEST(Damage, AccumulatesPlasticStrainOverFailureStrainAndFailsAtOne) {
         }
         // Sums of a few thousand terms, each rounded once as in the library; d eps_p read back from
         // the stored plastic strain telescopes, so the increments' read-back errors do not add up.
-        EXPECT_NEAR(p.state.damage, expected_damage, kRoundOff * std::max(expected_damage, 1e-3));
+        EXPECT_NEAR(p.state.damage, expected_damage, kFailureRoundOff * std::max(expected_damage, 1e-3));
         if (r.failed_now) {
             failure_step = step;
             eps_before_failure_step = eps_before;
@@ -126,7 +126,7 @@ TEST(Damage, AccumulatesPlasticStrainOverFailureStrainAndFailsAtOne) {
     EXPECT_LT(eps_before_failure_step, eps_f_max);
     // The damage differs from that with the old total-rate eps_f by far more than the tolerance above.
     EXPECT_GT(std::abs(p.state.damage - p.state.plastic_strain / eps_f_closed_form(f, 0.0, total_rate, 0.0)),
-              1e3 * kRoundOff);
+              1e3 * kFailureRoundOff);
     // Failed: no deviator, shear modulus gone from the sound speed.
     EXPECT_EQ(von_mises(p.state.deviatoric_stress), 0.0);
 
@@ -139,14 +139,14 @@ TEST(Damage, AccumulatesPlasticStrainOverFailureStrainAndFailsAtOne) {
     EXPECT_EQ(p.state.plastic_strain, eps_at_failure);
     EXPECT_EQ(r.plastic_work, 0.0);
     const double k_s = evaluate_eos(m.eos, m.density, p.density, p.state.specific_internal_energy).bulk_modulus;
-    EXPECT_NEAR(r.sound_speed, std::sqrt(k_s / p.density), kRoundOff * r.sound_speed);
+    EXPECT_NEAR(r.sound_speed, std::sqrt(k_s / p.density), kFailureRoundOff * r.sound_speed);
 
     // No tension: expanding gives P = 0, not K mu < 0; compression still carries pressure.
     p.step_to(Eigen::Matrix3d::Zero(), dt, 0.98 * m.density);
     EXPECT_EQ(p.state.pressure, 0.0);
     const double k = std::get<LinearEos>(m.eos).bulk_modulus;
     p.step_to(Eigen::Matrix3d::Zero(), dt, 1.01 * m.density);
-    EXPECT_NEAR(p.state.pressure, 0.01 * k, kRoundOff * k);
+    EXPECT_NEAR(p.state.pressure, 0.01 * k, kFailureRoundOff * k);
     EXPECT_TRUE(p.state.failed);
 }
 
@@ -178,11 +178,11 @@ TEST(Damage, UsesTriaxialityFromPressureAndVonMisesStress) {
     EXPECT_GT(sigma_star, 1.0);  // 1.4 GPa of tension over ~100 MPa of flow stress
     // eps_f at the step's plastic rate d eps_p / dt (above epsdot0, so D4 acts; below the total rate).
     const double rate = d_eps / dt;
-    EXPECT_NEAR(r.plastic_strain_rate, rate, kRoundOff * rate);
+    EXPECT_NEAR(r.plastic_strain_rate, rate, kFailureRoundOff * rate);
     EXPECT_GT(rate, m.failure.johnson_cook->reference_strain_rate);
     EXPECT_LT(rate, gamma_dot / std::sqrt(3.0));
     const double eps_f = eps_f_closed_form(*m.failure.johnson_cook, sigma_star, rate, 0.0);
-    EXPECT_NEAR(p.state.damage, d_eps / std::max(eps_f, 0.01), kRoundOff * p.state.damage);
+    EXPECT_NEAR(p.state.damage, d_eps / std::max(eps_f, 0.01), kFailureRoundOff * p.state.damage);
 }
 
 TEST(Damage, TriaxialityIsZeroWhereVonMisesStressVanishes) {
@@ -201,7 +201,7 @@ TEST(Damage, TriaxialityIsZeroWhereVonMisesStressVanishes) {
     const double eps_f = (0.05 + 0.05) * (1.0 + 0.01 * std::log(rate)) * (1.0 + 0.5);
     ASSERT_GT(p.state.plastic_strain, 0.0);
     EXPECT_EQ(von_mises(p.state.deviatoric_stress), 0.0);
-    EXPECT_NEAR(p.state.damage, p.state.plastic_strain / eps_f, kRoundOff * p.state.damage);
+    EXPECT_NEAR(p.state.damage, p.state.plastic_strain / eps_f, kFailureRoundOff * p.state.damage);
 }
 
 // Elastic copper-like point with a spall pressure of 1 GPa; P = K mu with K = 138.6 GPa.
@@ -222,7 +222,7 @@ TEST(Spall, TriggersBelowMinusSpallPressureOnlyWhenEnabled) {
         p.state.deviatoric_stress = {1e7, -1e7, 0.0, 0.0, 0.0, 2e6};
         PointResult r = p.step_to(Eigen::Matrix3d::Zero(), 1e-8, m.density * (1.0 + mu_above));
         EXPECT_FALSE(r.failed_now);
-        EXPECT_NEAR(p.state.pressure, -0.9e9, kRoundOff * k);
+        EXPECT_NEAR(p.state.pressure, -0.9e9, kFailureRoundOff * k);
         r = p.step_to(Eigen::Matrix3d::Zero(), 1e-8, m.density * (1.0 + mu_below));
         if (enabled) {
             EXPECT_TRUE(r.failed_now);
@@ -231,11 +231,11 @@ TEST(Spall, TriggersBelowMinusSpallPressureOnlyWhenEnabled) {
             EXPECT_EQ(von_mises(p.state.deviatoric_stress), 0.0);
             EXPECT_NEAR(r.sound_speed,
                         std::sqrt(evaluate_eos(m.eos, m.density, p.density, 0.0).bulk_modulus / p.density),
-                        kRoundOff * r.sound_speed);
+                        kFailureRoundOff * r.sound_speed);
         } else {
             EXPECT_FALSE(r.failed_now);
             EXPECT_FALSE(p.state.failed);
-            EXPECT_NEAR(p.state.pressure, -1.1e9, kRoundOff * k);
+            EXPECT_NEAR(p.state.pressure, -1.1e9, kFailureRoundOff * k);
             EXPECT_GT(von_mises(p.state.deviatoric_stress), 0.0);
         }
     }

@@ -21,7 +21,7 @@ using test::pure_shear;
 using test::to_matrix;
 
 // Exact relations evaluated in a handful of flops: agreement to a few ulp, 1e-12 relative.
-constexpr double kRoundOff = 1e-12;
+constexpr double kPointUpdateRoundOff = 1e-12;
 
 Eigen::Matrix3d deviatoric_rate(const Eigen::Matrix3d& l) {
     const Eigen::Matrix3d d = 0.5 * (l + l.transpose());
@@ -65,7 +65,7 @@ TEST(UniaxialStrain, ElasticSlopeHugoniotElasticLimitAndPlasticSlope) {
             EXPECT_NEAR(axial, (k + 4.0 * g / 3.0) * eps, 1e-11 * axial);
         } else {
             // On yield: sigma_xx - (-P) = s_xx = -2Y/3 (return to the surface, 1e-12 relative).
-            EXPECT_NEAR(p.state.deviatoric_stress[0], -2.0 * y / 3.0, kRoundOff * y);
+            EXPECT_NEAR(p.state.deviatoric_stress[0], -2.0 * y / 3.0, kPointUpdateRoundOff * y);
             // Perfect plasticity in uniaxial strain: eps_p = 2/3 (eps - Y / 2G), exact for the
             // radial return (also in the step that crosses yield).
             EXPECT_NEAR(p.state.plastic_strain, 2.0 / 3.0 * (eps - y / (2.0 * g)), 1e-10 * eps);
@@ -114,7 +114,7 @@ TEST(Heating, TemperatureRiseIsTaylorQuinneyPlasticWorkOverHeatCapacity) {
     }
     const double rise = p.state.temperature - m.room_temperature;
     // dT = beta dW_p / c_p step by step: the sum agrees to round-off.
-    EXPECT_NEAR(rise, m.taylor_quinney * plastic_work / m.specific_heat, kRoundOff * rise);
+    EXPECT_NEAR(rise, m.taylor_quinney * plastic_work / m.specific_heat, kPointUpdateRoundOff * rise);
     EXPECT_GT(rise, 20.0);  // ~0.3 * 250 MPa / (8930 * 383) * 0.9 ~ 20 K: far from zero
 
     // Independent check of the coupled heating: dT/d eps_p = beta Y(eps_p, rate, T*(T)) / (rho c_p),
@@ -192,11 +192,11 @@ TEST(Energy, ClosedShearLoopSplitsIntoPlasticWorkAndStoredElasticEnergy) {
     }
     const double de = p.state.specific_internal_energy;
     const double stored = to_matrix(p.state.deviatoric_stress).squaredNorm() / (4.0 * m.shear_modulus * m.density);
-    EXPECT_NEAR(de, stress_power, kRoundOff * max_energy);
+    EXPECT_NEAR(de, stress_power, kPointUpdateRoundOff * max_energy);
     EXPECT_NEAR(de, plastic_work + stored, 1e-10 * max_energy);
     EXPECT_GT(stored, 0.0);  // reverse yielding leaves a residual deviator
     EXPECT_NEAR(p.state.temperature - m.room_temperature, m.taylor_quinney * plastic_work / m.specific_heat,
-                kRoundOff * (p.state.temperature - m.room_temperature));
+                kPointUpdateRoundOff * (p.state.temperature - m.room_temperature));
 }
 
 TEST(Energy, HydrostaticCycleWithoutEnergyDependenceReturnsToStart) {
@@ -265,9 +265,9 @@ TEST(Energy, MieGruneisenSingleStepFromRestIsTheRankineHugoniotJump) {
         const double rho1 = m.density * (1.0 + mu);
         p.step_to(isotropic(m.density, rho1, 1e-8), 1e-8, rho1);
         const double p_h = copper_hugoniot_pressure(mu);
-        EXPECT_NEAR(p.state.pressure, p_h, kRoundOff * p_h) << mu;
+        EXPECT_NEAR(p.state.pressure, p_h, kPointUpdateRoundOff * p_h) << mu;
         EXPECT_NEAR(p.state.specific_internal_energy, p_h * mu / (2.0 * m.density * (1.0 + mu)),
-                    kRoundOff * p_h / m.density)
+                    kPointUpdateRoundOff * p_h / m.density)
             << mu;
     }
 }
@@ -289,7 +289,7 @@ TEST(Energy, MieGruneisenExactSolveMakesEnergyConsistentWithPressure) {
         const PointResult r = p.step(l, dt, q_old, q_new);
         const double rho_new = p.density;
         const EosResult eos = evaluate_eos(m.eos, m.density, rho_new, p.state.specific_internal_energy);
-        EXPECT_NEAR(p.state.pressure, eos.pressure, kRoundOff * std::abs(eos.pressure));
+        EXPECT_NEAR(p.state.pressure, eos.pressure, kPointUpdateRoundOff * std::abs(eos.pressure));
 
         const double dv = 1.0 / rho_new - 1.0 / rho_old;
         const Eigen::Matrix3d s_mid = 0.5 * (to_matrix(before.deviatoric_stress) + to_matrix(p.state.deviatoric_stress));
@@ -297,8 +297,8 @@ TEST(Energy, MieGruneisenExactSolveMakesEnergyConsistentWithPressure) {
         const double booked = dt / (0.5 * (rho_old + rho_new)) * s_mid.cwiseProduct(deviatoric_rate(l)).sum() -
                               (0.5 * (before.pressure + eos.pressure) + q_mid) * dv;
         const double scale = std::abs(p.state.specific_internal_energy) + std::abs(eos.pressure * dv);
-        EXPECT_NEAR(p.state.specific_internal_energy - before.specific_internal_energy, booked, kRoundOff * scale);
-        EXPECT_NEAR(r.viscous_work, -q_mid * dv, kRoundOff * std::abs(q_mid * dv));
+        EXPECT_NEAR(p.state.specific_internal_energy - before.specific_internal_energy, booked, kPointUpdateRoundOff * scale);
+        EXPECT_NEAR(r.viscous_work, -q_mid * dv, kPointUpdateRoundOff * std::abs(q_mid * dv));
         EXPECT_GT(r.viscous_work, 0.0);  // compression with Q > 0
         q_old = q_new;
     }
@@ -339,7 +339,7 @@ TEST(Energy, AFailedExpandedPointCompressedHardInOneStepNeedsNoEnergySolveWhenTh
     const EosResult eos = evaluate_eos(m.eos, m.density, inc.density_new, failed.specific_internal_energy);
     EXPECT_EQ(by_caller.specific_internal_energy, failed.specific_internal_energy);  // the caller's to change
     const double expected = std::max(eos.pressure, 0.0);  // no tension once failed
-    EXPECT_NEAR(by_caller.pressure, expected, kRoundOff * std::abs(eos.pressure));
+    EXPECT_NEAR(by_caller.pressure, expected, kPointUpdateRoundOff * std::abs(eos.pressure));
     EXPECT_TRUE(std::isfinite(r.sound_speed));
     EXPECT_GT(r.sound_speed, 0.0);
     EXPECT_TRUE(by_caller.failed);
@@ -349,17 +349,17 @@ TEST(SoundSpeed, ReferenceAndCompressedStates) {
     const Material m = test::copper();
     const double k0 = 8930.0 * 3940.0 * 3940.0;
     const double c_ref = std::sqrt((k0 + 4.0 * m.shear_modulus / 3.0) / m.density);
-    EXPECT_NEAR(reference_wave_speed(m), c_ref, kRoundOff * c_ref);
+    EXPECT_NEAR(reference_wave_speed(m), c_ref, kPointUpdateRoundOff * c_ref);
 
     Driver p(m);
     const PointResult at_rest = p.step(Eigen::Matrix3d::Zero(), 1e-8);
-    EXPECT_NEAR(at_rest.sound_speed, c_ref, kRoundOff * c_ref);
+    EXPECT_NEAR(at_rest.sound_speed, c_ref, kPointUpdateRoundOff * c_ref);
 
     const double rho1 = 1.2 * m.density;
     const PointResult compressed = p.step_to(isotropic(m.density, rho1, 1e-8), 1e-8, rho1);
     const double k_s = evaluate_eos(m.eos, m.density, rho1, p.state.specific_internal_energy).bulk_modulus;
     EXPECT_NEAR(compressed.sound_speed, std::sqrt((k_s + 4.0 * m.shear_modulus / 3.0) / rho1),
-                kRoundOff * compressed.sound_speed);
+                kPointUpdateRoundOff * compressed.sound_speed);
     EXPECT_GT(compressed.sound_speed, c_ref);
 }
 

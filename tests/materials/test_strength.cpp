@@ -23,7 +23,7 @@ using test::to_matrix;
 using test::von_mises;
 
 // Exact formulas evaluated in a handful of flops: agreement to a few ulp, 1e-12 relative.
-constexpr double kRoundOff = 1e-12;
+constexpr double kStrengthRoundOff = 1e-12;
 
 // The closed form of materials.md, with its edges written out: rate ratio floored at 1,
 // T* clamped to [0, 1], eps_p^n = 0 at eps_p = 0.
@@ -42,7 +42,7 @@ TEST(JohnsonCookFlowStress, MatchesClosedFormInsideTheRange) {
             for (double t_star : {0.0, 0.2, 0.7, 0.99}) {
                 const double expected = (90e6 + 292e6 * std::pow(eps, 0.31)) * (1.0 + 0.025 * std::log(rate)) *
                                         (1.0 - std::pow(t_star, 1.09));
-                EXPECT_NEAR(johnson_cook_flow_stress(kCopper, eps, rate, t_star), expected, kRoundOff * expected)
+                EXPECT_NEAR(johnson_cook_flow_stress(kCopper, eps, rate, t_star), expected, kStrengthRoundOff * expected)
                     << eps << " " << rate << " " << t_star;
             }
         }
@@ -65,19 +65,19 @@ TEST(JohnsonCookFlowStress, GuardedEdges) {
     EXPECT_EQ(johnson_cook_flow_stress(kCopper, 0.2, 1e3, 1.7), 0.0);
     // eps_p = 0: eps_p^n = 0, Y = A (rate factor)(thermal factor).
     const double y0 = johnson_cook_flow_stress(kCopper, 0.0, 1e3, 0.25);
-    EXPECT_NEAR(y0, 90e6 * (1.0 + 0.025 * std::log(1e3)) * (1.0 - std::pow(0.25, 1.09)), kRoundOff * y0);
+    EXPECT_NEAR(y0, 90e6 * (1.0 + 0.025 * std::log(1e3)) * (1.0 - std::pow(0.25, 1.09)), kStrengthRoundOff * y0);
     // A non-unit reference rate divides the rate.
     JohnsonCookStrength slow = kCopper;
     slow.reference_strain_rate = 1e-3;
     EXPECT_NEAR(johnson_cook_flow_stress(slow, 0.2, 1.0, 0.0), jc_closed_form(kCopper, 0.2, 1e3, 0.0),
-                kRoundOff * y_static);
+                kStrengthRoundOff * y_static);
 }
 
 TEST(HomologousTemperature, ClampsAndHandlesNoMelt) {
     Material m = test::copper();  // room 294 K, melt 1356 K
     EXPECT_EQ(homologous_temperature(m, 200.0), 0.0);
     EXPECT_EQ(homologous_temperature(m, 294.0), 0.0);
-    EXPECT_NEAR(homologous_temperature(m, 825.0), 0.5, kRoundOff);
+    EXPECT_NEAR(homologous_temperature(m, 825.0), 0.5, kStrengthRoundOff);
     EXPECT_EQ(homologous_temperature(m, 1356.0), 1.0);
     EXPECT_EQ(homologous_temperature(m, 2000.0), 1.0);
     // Through the temperature: below room behaves as room, above melt gives Y = 0.
@@ -185,14 +185,14 @@ TEST(RadialReturn, JohnsonCookWithHardeningLandsOnTheYieldSurface) {
                 // strain and the reported rate are those two floating-point values, so the closed form
                 // there agrees with the returned deviator to round-off.
                 const double y_end = jc_closed_form(c.jc, eps_after, r.plastic_strain_rate, t_star);
-                EXPECT_NEAR(von_mises(p.state.deviatoric_stress), y_end, kRoundOff * y_end) << c.name;
+                EXPECT_NEAR(von_mises(p.state.deviatoric_stress), y_end, kStrengthRoundOff * y_end) << c.name;
                 // Consistency of the increment: sigma* - 3 G d eps_p = Y(eps_p + d eps_p, d eps_p / dt).
                 // The return stops at |residual| <= 1e-13 sigma*; the test's sigma* (the trial without
                 // the library's symmetrisation) differs by round-off; and the read-back d eps_p by at
                 // most the read-back bound, times 3 G. f falls with slope >= 3 G, so this residual also
-                // pins d eps_p to the root within kRoundOff sigma* / (3 G).
+                // pins d eps_p to the root within kStrengthRoundOff sigma* / (3 G).
                 EXPECT_NEAR(sigma_trial - 3.0 * m.shear_modulus * d_eps, y_end,
-                            kRoundOff * sigma_trial +
+                            kStrengthRoundOff * sigma_trial +
                                 3.0 * m.shear_modulus * test::increment_read_back_tolerance(eps_after))
                     << c.name;
             } else {
@@ -262,17 +262,17 @@ TEST(RadialReturn, FirstYieldFromZeroPlasticStrain) {
     // The rate is the plastic one, d eps_p / dt: below the total equivalent rate gamma_dot / sqrt(3),
     // since part of the step's strain is elastic.
     const double rate = d_eps / dt;
-    EXPECT_NEAR(r.plastic_strain_rate, rate, kRoundOff * rate);
+    EXPECT_NEAR(r.plastic_strain_rate, rate, kStrengthRoundOff * rate);
     EXPECT_LT(rate, gamma_dot / std::sqrt(3.0));
     EXPECT_GT(rate, kCopper.reference_strain_rate);  // the rate term is active
     const double sigma_trial = std::sqrt(3.0) * m.shear_modulus * gamma_dot * dt;  // s_xy = G gamma
     const double y = jc_closed_form(kCopper, d_eps, rate, 0.0);
     // On the yield surface and consistent, both to round-off (the return's residual is <= 1e-13 sigma*).
-    EXPECT_NEAR(von_mises(p.state.deviatoric_stress), y, kRoundOff * y);
-    EXPECT_NEAR(sigma_trial - 3.0 * m.shear_modulus * d_eps, y, kRoundOff * sigma_trial);
+    EXPECT_NEAR(von_mises(p.state.deviatoric_stress), y, kStrengthRoundOff * y);
+    EXPECT_NEAR(sigma_trial - 3.0 * m.shear_modulus * d_eps, y, kStrengthRoundOff * sigma_trial);
     // The checks tell the definitions apart: Y at the total rate is off by far more than round-off.
     const double y_total_rate = jc_closed_form(kCopper, d_eps, gamma_dot / std::sqrt(3.0), 0.0);
-    EXPECT_GT(std::abs(von_mises(p.state.deviatoric_stress) - y_total_rate), 1e6 * kRoundOff * y);
+    EXPECT_GT(std::abs(von_mises(p.state.deviatoric_stress) - y_total_rate), 1e6 * kStrengthRoundOff * y);
 }
 
 TEST(RadialReturn, JohnsonCookRateIsThePlasticRateSoAShorterStepHardensMore) {
@@ -298,9 +298,9 @@ TEST(RadialReturn, JohnsonCookRateIsThePlasticRateSoAShorterStepHardensMore) {
             const double sigma_trial = std::sqrt(3.0) * m.shear_modulus * gamma;
             const double y = jc_closed_form(jc, d_eps, d_eps / dt, 0.0);
             EXPECT_GT(d_eps, 0.0) << dt;
-            EXPECT_NEAR(r.plastic_strain_rate, d_eps / dt, kRoundOff * d_eps / dt) << dt;
-            EXPECT_NEAR(von_mises(p.state.deviatoric_stress), y, kRoundOff * y) << dt;
-            EXPECT_NEAR(sigma_trial - 3.0 * m.shear_modulus * d_eps, y, kRoundOff * sigma_trial) << dt;
+            EXPECT_NEAR(r.plastic_strain_rate, d_eps / dt, kStrengthRoundOff * d_eps / dt) << dt;
+            EXPECT_NEAR(von_mises(p.state.deviatoric_stress), y, kStrengthRoundOff * y) << dt;
+            EXPECT_NEAR(sigma_trial - 3.0 * m.shear_modulus * d_eps, y, kStrengthRoundOff * sigma_trial) << dt;
             out.push_back({d_eps, r.plastic_strain_rate, von_mises(p.state.deviatoric_stress)});
         }
         return out;
@@ -325,12 +325,12 @@ TEST(RadialReturn, JohnsonCookRateIsThePlasticRateSoAShorterStepHardensMore) {
     rate_free.c = 0.0;
     const std::vector<Outcome> unrated = run(rate_free);
     for (std::size_t i = 1; i < unrated.size(); ++i) {
-        EXPECT_NEAR(unrated[i].d_eps, unrated[0].d_eps, kRoundOff * unrated[0].d_eps) << i;
-        EXPECT_NEAR(unrated[i].flow_stress, unrated[0].flow_stress, kRoundOff * unrated[0].flow_stress) << i;
-        EXPECT_NEAR(unrated[i].rate * steps[i], unrated[0].rate * steps[0], kRoundOff * unrated[0].d_eps) << i;
+        EXPECT_NEAR(unrated[i].d_eps, unrated[0].d_eps, kStrengthRoundOff * unrated[0].d_eps) << i;
+        EXPECT_NEAR(unrated[i].flow_stress, unrated[0].flow_stress, kStrengthRoundOff * unrated[0].flow_stress) << i;
+        EXPECT_NEAR(unrated[i].rate * steps[i], unrated[0].rate * steps[0], kStrengthRoundOff * unrated[0].d_eps) << i;
     }
     // ... and it is the rate-independent return of copper's (A + B eps_p^n).
-    EXPECT_NEAR(unrated[0].flow_stress, 90e6 + 292e6 * std::pow(unrated[0].d_eps, 0.31), kRoundOff * unrated[0].flow_stress);
+    EXPECT_NEAR(unrated[0].flow_stress, 90e6 + 292e6 * std::pow(unrated[0].d_eps, 0.31), kStrengthRoundOff * unrated[0].flow_stress);
 
     // The elastic check is made at zero plastic rate: a trial just above A yields, although it is
     // below the flow stress at the step's total rate (A (1 + C ln(gamma / (sqrt(3) dt))) ~ 1.16 A here).
@@ -344,9 +344,9 @@ TEST(RadialReturn, JohnsonCookRateIsThePlasticRateSoAShorterStepHardensMore) {
     const double d_eps = p.state.plastic_strain;
     EXPECT_GT(d_eps, 0.0);
     const double y = jc_closed_form(kCopper, d_eps, d_eps / dt, 0.0);
-    EXPECT_NEAR(r.plastic_strain_rate, d_eps / dt, kRoundOff * d_eps / dt);
-    EXPECT_NEAR(von_mises(p.state.deviatoric_stress), y, kRoundOff * y);
-    EXPECT_NEAR(sigma_trial - 3.0 * m.shear_modulus * d_eps, y, kRoundOff * sigma_trial);
+    EXPECT_NEAR(r.plastic_strain_rate, d_eps / dt, kStrengthRoundOff * d_eps / dt);
+    EXPECT_NEAR(von_mises(p.state.deviatoric_stress), y, kStrengthRoundOff * y);
+    EXPECT_NEAR(sigma_trial - 3.0 * m.shear_modulus * d_eps, y, kStrengthRoundOff * sigma_trial);
 }
 
 TEST(RadialReturn, ElasticStepBelowYieldHasNoPlasticFlow) {
@@ -361,7 +361,7 @@ TEST(RadialReturn, ElasticStepBelowYieldHasNoPlasticFlow) {
         EXPECT_EQ(p.state.plastic_strain, 0.0);
         EXPECT_EQ(r.plastic_work, 0.0);
         EXPECT_EQ(p.state.temperature, t_before);
-        EXPECT_LE((to_matrix(p.state.deviatoric_stress) - expected).norm(), kRoundOff * expected.norm());
+        EXPECT_LE((to_matrix(p.state.deviatoric_stress) - expected).norm(), kStrengthRoundOff * expected.norm());
     }
     EXPECT_LT(von_mises(p.state.deviatoric_stress), 90e6);
 }
@@ -372,7 +372,7 @@ TEST(RadialReturn, ElasticMaterialNeverReturns) {
     Driver p(m);
     const double gamma_dot = 1e4, dt = 1e-5;  // shear strain 0.1: sigma_vm ~ 4.5 GPa
     p.step(pure_shear(gamma_dot), dt);
-    EXPECT_NEAR(p.state.deviatoric_stress[5], m.shear_modulus * gamma_dot * dt, kRoundOff * 2.6e9);
+    EXPECT_NEAR(p.state.deviatoric_stress[5], m.shear_modulus * gamma_dot * dt, kStrengthRoundOff * 2.6e9);
     EXPECT_EQ(p.state.plastic_strain, 0.0);
 }
 
@@ -384,9 +384,9 @@ TEST(RadialReturn, MoltenPointCarriesNoDeviatorAndNoShearStiffness) {
     const PointResult r = p.step(pure_shear(gamma_dot), dt);
     EXPECT_EQ(von_mises(p.state.deviatoric_stress), 0.0);
     // Y = 0: all the trial strain is plastic, d eps_p = sigma* / (3 G) = gamma / sqrt(3).
-    EXPECT_NEAR(p.state.plastic_strain, gamma_dot * dt / std::sqrt(3.0), kRoundOff);
+    EXPECT_NEAR(p.state.plastic_strain, gamma_dot * dt / std::sqrt(3.0), kStrengthRoundOff);
     const double k_s = evaluate_eos(m.eos, m.density, p.density, p.state.specific_internal_energy).bulk_modulus;
-    EXPECT_NEAR(r.sound_speed, std::sqrt(k_s / p.density), kRoundOff * r.sound_speed);
+    EXPECT_NEAR(r.sound_speed, std::sqrt(k_s / p.density), kStrengthRoundOff * r.sound_speed);
 }
 
 TEST(Jaumann, OneStepMatchesTheRateFormula) {
@@ -399,7 +399,7 @@ TEST(Jaumann, OneStepMatchesTheRateFormula) {
     const double dt = 1e-7;
     const Eigen::Matrix3d expected = jaumann_trial(to_matrix(p.state.deviatoric_stress), l, m.shear_modulus, dt);
     p.step(l, dt);
-    EXPECT_LE((to_matrix(p.state.deviatoric_stress) - expected).norm(), kRoundOff * expected.norm());
+    EXPECT_LE((to_matrix(p.state.deviatoric_stress) - expected).norm(), kStrengthRoundOff * expected.norm());
 }
 
 TEST(Jaumann, PureSpinRotatesTheDeviator) {

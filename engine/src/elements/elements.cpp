@@ -30,7 +30,7 @@ using element::Vec2;
 namespace {
 
 constexpr std::size_t quad_grain = 256;
-constexpr NodeIndex no_node = std::numeric_limits<NodeIndex>::max();
+constexpr NodeIndex no_mesh_node = std::numeric_limits<NodeIndex>::max();
 constexpr std::size_t max_planes = 8;  // ElementNodes::held and ::contact are bit masks of 8 planes
 
 Vec2 position_of(const ElementNodes& n, std::size_t i) { return {n.position[0][i], n.position[1][i]}; }
@@ -113,7 +113,7 @@ void mesh_body(const Scene& scene, std::size_t b, ElementMesh& mesh) {
     const double sx = block.spacing[0], sz = block.spacing[1];
     mesh.body_spacing[b] = std::min(sx, sz);
 
-    std::vector<NodeIndex> corner(static_cast<std::size_t>((nx + 1) * (nz + 1)), no_node);
+    std::vector<NodeIndex> corner(static_cast<std::size_t>((nx + 1) * (nz + 1)), no_mesh_node);
     const auto add_node = [&](double x, double z) {
         const std::size_t i = mesh.nodes.size();
         mesh.nodes.resize(i + 1);
@@ -127,7 +127,7 @@ void mesh_body(const Scene& scene, std::size_t b, ElementMesh& mesh) {
     };
     const auto corner_node = [&](std::int64_t i, std::int64_t k) {
         NodeIndex& n = corner[static_cast<std::size_t>(k * (nx + 1) + i)];
-        if (n == no_node) n = add_node(block.origin[0] + double(block.first[0] + i) * sx, block.origin[1] + double(block.first[1] + k) * sz);
+        if (n == no_mesh_node) n = add_node(block.origin[0] + double(block.first[0] + i) * sx, block.origin[1] + double(block.first[1] + k) * sz);
         return n;
     };
     const std::size_t first_quad = mesh.quads.size();
