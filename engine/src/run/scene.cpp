@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdint>
 #include <exception>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -749,26 +750,33 @@ double cylinder_radius_at(const BodySpec& b, double height) {
 }
 
 
-bool symmetry_plane_cuts(const Scene& scene, std::size_t body, std::size_t plane) {
+namespace {
+
+// Body `body`'s extent along the normal of scene.planes[plane], the plane's position and the
+// tolerance of "on the plane"; none unless the plane is a valid symmetry plane.
+struct SymmetrySpan {
+    double lo, hi, position, tolerance;
+};
+std::optional<SymmetrySpan> symmetry_span(const Scene& scene, std::size_t body, std::size_t plane) {
     const int dim = dimension_of(scene.geometry);
-    if (body >= scene.bodies.size() || plane >= scene.planes.size()) return false;
+    if (body >= scene.bodies.size() || plane >= scene.planes.size()) return std::nullopt;
     const PlaneSpec& p = scene.planes[plane];
-    if (p.kind != PlaneKind::Symmetry || p.axis < 0 || p.axis >= dim || !finite(p.position)) return false;
+    if (p.kind != PlaneKind::Symmetry || p.axis < 0 || p.axis >= dim || !finite(p.position)) return std::nullopt;
     const BodySpec& b = scene.bodies[body];
     const auto [lo, hi] = extent(b, scene.geometry, p.axis);
-    const double tolerance = 1e-9 * std::max(b.spacing, std::abs(p.position));
-    return lo < p.position - tolerance && hi > p.position + tolerance;
+    return SymmetrySpan{lo, hi, p.position, 1e-9 * std::max(b.spacing, std::abs(p.position))};
+}
+
+}  // namespace
+
+bool symmetry_plane_cuts(const Scene& scene, std::size_t body, std::size_t plane) {
+    const auto s = symmetry_span(scene, body, plane);
+    return s && s->lo < s->position - s->tolerance && s->hi > s->position + s->tolerance;
 }
 
 bool reaches_symmetry_plane(const Scene& scene, std::size_t body, std::size_t plane) {
-    const int dim = dimension_of(scene.geometry);
-    if (body >= scene.bodies.size() || plane >= scene.planes.size()) return false;
-    const PlaneSpec& p = scene.planes[plane];
-    if (p.kind != PlaneKind::Symmetry || p.axis < 0 || p.axis >= dim || !finite(p.position)) return false;
-    const BodySpec& b = scene.bodies[body];
-    const auto [lo, hi] = extent(b, scene.geometry, p.axis);
-    const double tolerance = 1e-9 * std::max(b.spacing, std::abs(p.position));
-    return lo < p.position + tolerance && hi > p.position - tolerance;
+    const auto s = symmetry_span(scene, body, plane);
+    return s && s->lo < s->position + s->tolerance && s->hi > s->position - s->tolerance;
 }
 
 int symmetry_copies(const Scene& scene, std::size_t body) {

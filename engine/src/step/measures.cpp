@@ -25,17 +25,24 @@ void add_to_extent(measure::Extent& e, const NodeStore& nodes, std::size_t i, co
     const double cell = measure::particle_cell_size(nodes.size_weight[i], d);
     const int first = plane.axis == 0 ? 1 : 0;
     const int second = plane.axis == 2 ? 1 : 2;  // 3D only
+    const auto add = [&](double along_first, double along_second) {
+        if (d == 3) {
+            measure::add_particle_3d(e, height, along_first, along_second, cell);
+        } else {
+            measure::add_particle(e, height, along_first, cell, axisymmetric && first == 0);
+        }
+    };
+    if (mirrors.empty()) {  // the whole body (most scenes, every step): no images to make
+        add(nodes.position[first][i], d == 3 ? nodes.position[second][i] : 0.0);
+        return;
+    }
     const std::size_t images = std::size_t{1} << mirrors.size();
     for (std::size_t mask = 0; mask < images; ++mask) {
         std::array<double, 3> x{nodes.position[0][i], nodes.position[1][i], d == 3 ? nodes.position[2][i] : 0.0};
         for (std::size_t k = 0; k < mirrors.size(); ++k) {
             if (mask & (std::size_t{1} << k)) x[mirrors[k].axis] = 2.0 * mirrors[k].position - x[mirrors[k].axis];
         }
-        if (d == 3) {
-            measure::add_particle_3d(e, height, x[first], x[second], cell);
-        } else {
-            measure::add_particle(e, height, x[first], cell, axisymmetric && first == 0);
-        }
+        add(x[first], x[second]);
     }
 }
 
