@@ -11,6 +11,7 @@
 
 #include "gpa/engine/drivers.hpp"
 #include "gpa/engine/neighbours.hpp"
+#include "gpa/engine/smoothing.hpp"
 #include "support/lattices.hpp"
 
 namespace gpa {
@@ -289,6 +290,87 @@ TEST_P(Conservation, StressPowerAtOtherVelocitiesWithTheMomentMatrixNormalisatio
     // terms and sigma_i N_i is not symmetric, so a transposed contraction would show here.
     const ForceCase s = GetParam();
     dispatch_geometry(s.geometry, [&](auto g) { check_stress_power<decltype(g)>(s, true); });
+}
+
+// The pair terms the gradient sweep keeps (fields.hpp, PairFields::kept_weight) are the weight and
+// inverse distance that pair() makes, and the sweeps that read them (forces, stress power,
+// smoothing) give what they give without them, bit for bit, on rows that have them and on rows
+// that do not (the ghost rows of a run).
+template <class G>
+void check_kept_pair_terms(const ForceCase& s, bool full_normalisation) {
+    constexpr int D = G::dim;
+    NodeStore fresh = random_body(s);
+    const CompressedRows lists = find_neighbours(fresh, influence, fresh.size());
+    NodeStore kept = fresh;
+    std::vector<double> weight(lists.entries(), -1.0), inverse_distance(lists.entries(), -1.0);
+    // The gradient with and without keeping: the same outputs, and the kept numbers are pair()'s.
+    auto g_fresh = gradient_fields<D>(fresh, influence);
+    auto g_kept = gradient_fields<D>(kept, influence);
+    g_fresh.full_normalisation = g_kept.full_normalisation = full_normalisation;
+    g_kept.keep_weight = weight.data();
+    g_kept.keep_inverse_distance = inverse_distance.data();
+    compute_velocity_gradient<G>(lists, s.weight, g_fresh);
+    compute_velocity_gradient<G>(lists, s.weight, g_kept);
+    for (std::size_t i = 0; i < fresh.size(); ++i) {
+        for (int k = 0; k < D * D; ++k) ASSERT_EQ(fresh.velocity_gradient[k][i], kept.velocity_gradient[k][i]) << name(s);
+        const auto row = lists.row(i);
+        for (std::size_t k = 0; k < row.size(); ++k) {
+            const auto p = dispatch_weight(s.weight, [&](auto w) { return g_fresh.pairs.template pair<decltype(w)>(i, row[k]); });
+            ASSERT_EQ(weight[lists.offsets[i] + k], p.R) << name(s) << " centre " << i;
+            ASSERT_EQ(inverse_distance[lists.offsets[i] + k], p.inv_r) << name(s) << " centre " << i;
+        }
+    }
+    // The forces, the stress power and the smoothing, with the kept terms for the first half of
+    // the rows (the rest make their own) and without any.
+    const std::size_t kept_rows = fresh.size() / 2;
+    const auto with_kept = [&](PairFields<D> p) {
+        p.kept_weight = weight.data();
+        p.kept_inverse_distance = inverse_distance.data();
+        p.kept_rows = kept_rows;
+        return p;
+    };
+    const auto x = PositionView{D, {fresh.position[0].data(), fresh.position[1].data(), D == 3 ? fresh.position[2].data() : nullptr}};
+    const ScatterPlan plan = make_slab_plan(lists, x);
+    const BondViscosityParameters bond;
+    for (const BondViscosityParameters* b : {static_cast<const BondViscosityParameters*>(nullptr), &bond}) {
+        auto f_fresh = force_fields<D>(fresh, influence);
+        auto f_kept = force_fields<D>(kept, influence);
+        f_kept.pairs = with_kept(f_kept.pairs);
+        f_fresh.full_normalisation = f_kept.full_normalisation = full_normalisation;
+        compute_forces<G>(lists, plan, s.weight, b, f_fresh, fresh.size());
+        compute_forces<G>(lists, plan, s.weight, b, f_kept, kept.size());
+        for (std::size_t i = 0; i < fresh.size(); ++i) {
+            for (int c = 0; c < D; ++c) ASSERT_EQ(fresh.force[c][i], kept.force[c][i]) << name(s) << (b ? " bond" : "");
+        }
+        std::vector<double> power_fresh(fresh.size()), viscous_fresh(fresh.size()), power_kept(fresh.size()), viscous_kept(fresh.size());
+        std::array<const double*, D> v{};
+        for (int c = 0; c < D; ++c) v[c] = fresh.velocity[c].data();
+        compute_stress_power<G>(lists, s.weight, f_fresh, v, fresh.size(), power_fresh.data(), viscous_fresh.data());
+        compute_stress_power<G>(lists, s.weight, f_kept, v, kept.size(), power_kept.data(), viscous_kept.data());
+        EXPECT_EQ(power_fresh, power_kept) << name(s);
+        EXPECT_EQ(viscous_fresh, viscous_kept) << name(s);
+    }
+    SmoothingScratch scratch_fresh, scratch_kept;
+    std::array<double*, D> v_fresh{}, v_kept{};
+    for (int c = 0; c < D; ++c) {
+        v_fresh[c] = fresh.velocity[c].data();
+        v_kept[c] = kept.velocity[c].data();
+    }
+    const SmoothingOptions o;
+    const double heat_fresh = smooth_velocities<G>(lists, plan, s.weight, pair_fields<D>(fresh, influence), fresh.size(), o, v_fresh,
+                                                   fresh.mass.data(), fresh.pressure.data(), fresh.internal_energy.data(), scratch_fresh);
+    const double heat_kept = smooth_velocities<G>(lists, plan, s.weight, with_kept(pair_fields<D>(kept, influence)), kept.size(), o,
+                                                  v_kept, kept.mass.data(), kept.pressure.data(), kept.internal_energy.data(), scratch_kept);
+    EXPECT_EQ(heat_fresh, heat_kept) << name(s);
+    for (int c = 0; c < D; ++c) EXPECT_EQ(fresh.velocity[c], kept.velocity[c]) << name(s);
+}
+
+TEST_P(Conservation, KeptPairTermsGiveTheSameNumbersBitForBit) {
+    const ForceCase s = GetParam();
+    dispatch_geometry(s.geometry, [&](auto g) {
+        check_kept_pair_terms<decltype(g)>(s, false);
+        check_kept_pair_terms<decltype(g)>(s, true);
+    });
 }
 
 INSTANTIATE_TEST_SUITE_P(AllGeometries, Conservation, ::testing::ValuesIn(setups()),

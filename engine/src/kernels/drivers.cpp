@@ -89,14 +89,22 @@ template <class G, class W, bool full>
 void gradient_impl(const CompressedRows& lists, const GradientFields<G::dim>& f, std::size_t n) {
     constexpr int D = G::dim;
     std::atomic<std::size_t> first_bad{no_node};
+    const bool keep = f.keep_weight != nullptr;
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, row_grain), [&](const tbb::blocked_range<std::size_t>& range) {
         for (std::size_t i = range.begin(); i != range.end(); ++i) {
             const Vec<D> v_i = load<D>(f.velocity, i);
             GradientSums<D> sums;
             bool ok = true;
-            for (NodeIndex j : lists.row(i)) {
+            const std::size_t first = lists.offsets[i];
+            const auto row = lists.row(i);
+            for (std::size_t k = 0; k < row.size(); ++k) {
+                const NodeIndex j = row[k];
                 const auto p = f.pairs.template pair<W>(i, j);
                 ok &= p.r > 0.0;
+                if (keep) {
+                    f.keep_weight[first + k] = p.R;
+                    f.keep_inverse_distance[first + k] = p.inv_r;
+                }
                 Vec<D> dv = load<D>(f.velocity, j) - v_i;
                 if (f.pairs.sliding(i, j)) dv = along_pair<D>(f.pairs.sliding_normal(i, j, p.l), dv);  // spec section 2
                 accumulate_gradient<D, full>(p, f.size_weight[j], dv, sums);
@@ -187,8 +195,12 @@ void forces_impl(const CompressedRows& lists, const ScatterPlan& plan, const Bon
             density = f.mass[i] / volume;
             sound_speed = f.sound_speed[i];
         }
-        for (NodeIndex j : lists.row(i)) {
-            const auto p = f.pairs.template pair<W>(i, j);
+        const std::size_t first = lists.offsets[i];
+        const auto row = lists.row(i);
+        for (std::size_t k = 0; k < row.size(); ++k) {
+            const NodeIndex j = row[k];
+            // The bond viscosity reads r and h, which the kept pairs leave out (fields.hpp).
+            const auto p = with_bond_viscosity ? f.pairs.template pair<W>(i, j) : f.pairs.template pair<W>(i, j, first + k);
             const bool sliding = f.pairs.sliding(i, j);  // spec section 2: one direction only
             [[maybe_unused]] const Vec<D> n = sliding ? f.pairs.sliding_normal(i, j, p.l) : p.l;  // contact normal, read only when sliding
             double q = 0.0;
@@ -257,8 +269,11 @@ void stress_power_impl(const CompressedRows& lists, const ForceFields<G::dim>& f
             // The row's sum of velocity differences B_i (kernels.hpp, accumulate_velocity_difference):
             // power -V_i (sigma_i N_i) : B_i, divergence N_i : B_i, no pair force made.
             Mat<D> difference = Mat<D>::Zero();
-            for (NodeIndex j : lists.row(i)) {
-                const auto p = f.pairs.template pair<W>(i, j);
+            const std::size_t first = lists.offsets[i];
+            const auto row = lists.row(i);
+            for (std::size_t k = 0; k < row.size(); ++k) {
+                const NodeIndex j = row[k];
+                const auto p = f.pairs.template pair<W>(i, j, first + k);
                 Vec<D> dv = load<D>(velocity, j) - v_i;
                 if (f.pairs.sliding(i, j)) dv = along_pair<D>(f.pairs.sliding_normal(i, j, p.l), dv);  // spec section 2
                 accumulate_velocity_difference<D>(p, f.size_weight[j], dv, difference);

@@ -24,11 +24,14 @@ double smooth_impl(const CompressedRows& lists, const ScatterPlan& plan, const P
             if (options.tension_only && !(pressure[i] < 0.0)) continue;
             double weight_sum = 0.0, weighted_mass = 0.0;
             Vec<D> weighted_v = Vec<D>::Zero();
-            for (NodeIndex j : lists.row(i)) {
+            const std::size_t first = lists.offsets[i];
+            const auto row = lists.row(i);
+            for (std::size_t k = 0; k < row.size(); ++k) {
+                const NodeIndex j = row[k];
                 // Ghosts take no part, nor do contacts and cracks (spec section 2, "[spec] Sliding
                 // contact": averaging velocities across them would be friction).
                 if (j >= n || pairs.sliding(i, j)) continue;
-                const double R = pairs.template pair<W>(i, j).R;
+                const double R = pairs.template weight<W>(i, j, first + k);
                 weight_sum += R;
                 weighted_mass += R * mass[j];
                 for (int c = 0; c < D; ++c) weighted_v[c] += R * v[c][j];
@@ -49,9 +52,12 @@ double smooth_impl(const CompressedRows& lists, const ScatterPlan& plan, const P
                                       if (i >= n || scratch.share[i] == 0.0) continue;
                                       const double* dv = &scratch.centre_change[D * i];
                                       for (int c = 0; c < D; ++c) scratch.total_change[D * i + c] += dv[c];
-                                      for (NodeIndex j : lists.row(i)) {
+                                      const std::size_t first = lists.offsets[i];
+                                      const auto row = lists.row(i);
+                                      for (std::size_t k = 0; k < row.size(); ++k) {
+                                          const NodeIndex j = row[k];
                                           if (j >= n || pairs.sliding(i, j)) continue;
-                                          const double f = -scratch.share[i] * pairs.template pair<W>(i, j).R;
+                                          const double f = -scratch.share[i] * pairs.template weight<W>(i, j, first + k);
                                           for (int c = 0; c < D; ++c) scratch.total_change[D * j + c] += f * dv[c];
                                       }
                                   }

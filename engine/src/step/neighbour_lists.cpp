@@ -55,6 +55,15 @@ void NeighbourLists::set_up(bool constant) {
 void NeighbourLists::invalidate() {
     lists_.clear();  // rebuilt in the new numbering by the next update
     search_due_ = true;
+    kept_rows_ = 0;
+}
+
+NeighbourLists::PairTerms NeighbourLists::keep_pairs(std::size_t real) {
+    kept_rows_ = 0;
+    const std::size_t entries = lists_.offsets[std::min(real, lists_.rows())];
+    resize_with_slack(kept_weight_, entries);
+    resize_with_slack(kept_inverse_distance_, entries);
+    return {kept_weight_.data(), kept_inverse_distance_.data()};
 }
 
 void NeighbourLists::place_ghosts(NodeStore& nodes, std::size_t real, GhostSet& ghosts, InfluenceDistance influence_distance, bool first) {
@@ -241,6 +250,7 @@ void NeighbourLists::search_candidates(NodeStore& nodes, std::size_t real, Ghost
 
 void NeighbourLists::update(NodeStore& nodes, std::size_t real, GhostSet& ghosts, InfluenceDistance influence_distance, bool any_automatic,
                             Contact& contact, std::size_t step) {
+    kept_rows_ = 0;
     if (constant_ && lists_.rows() == real) return;
     const int d = nodes.dim();
     if (with_skin_) {
@@ -312,6 +322,7 @@ void NeighbourLists::read_state(StateReader& in, int dim, std::size_t node_count
 
 void NeighbourLists::memory_use(MemoryUse& out) const {
     add_memory(out, "neighbour lists: lists", allocated_bytes(lists_.indices) + allocated_bytes(lists_.offsets));
+    add_memory(out, "neighbour lists: kept pair terms", allocated_bytes(kept_weight_) + allocated_bytes(kept_inverse_distance_));
     add_memory(out, "neighbour lists: skin candidates", allocated_bytes(candidates_.indices) + allocated_bytes(candidates_.offsets) +
                                                             allocated_bytes(lattice_entries_) + allocated_bytes(keep_scratch_) +
                                                             allocated_bytes(quiet_) + allocated_bytes(searched_fixed_));

@@ -18,6 +18,7 @@
 
 #include "gpa/engine/colouring.hpp"
 #include "gpa/engine/compressed_rows.hpp"
+#include "gpa/engine/fields.hpp"
 #include "gpa/engine/ghosts.hpp"
 #include "gpa/engine/neighbours.hpp"
 #include "gpa/engine/node_store.hpp"
@@ -39,6 +40,26 @@ public:
     void set_entry_check(std::function<void(std::size_t)> check) { scratch_.check_entries = std::move(check); }
 
     const CompressedRows& rows() const { return lists_; }
+
+    // Each pair's R_ij and 1 / r_ij for the sweeps of a step (fields.hpp, PairFields::kept_weight):
+    // keep_pairs gives the gradient sweep arrays for the entries of the rows [0, real) to write,
+    // pairs_kept says it has, and with_kept_pairs hands them to the sweeps after it. They are
+    // forgotten when the positions move (forget_kept_pairs, the move phase) and when the lists
+    // change. Not checkpointed: every step makes them again before it reads them.
+    struct PairTerms {
+        double* weight;
+        double* inverse_distance;
+    };
+    PairTerms keep_pairs(std::size_t real);
+    void pairs_kept(std::size_t real) { kept_rows_ = real; }
+    void forget_kept_pairs() { kept_rows_ = 0; }
+    template <int D>
+    PairFields<D> with_kept_pairs(PairFields<D> pairs) const {
+        pairs.kept_weight = kept_weight_.data();
+        pairs.kept_inverse_distance = kept_inverse_distance_.data();
+        pairs.kept_rows = kept_rows_;
+        return pairs;
+    }
     const ScatterPlan& plan() const { return plan_; }
     std::size_t searches() const { return searches_; }
 
@@ -96,6 +117,8 @@ private:
     std::array<std::vector<double>, 3> searched_position_;
     std::vector<double> searched_diameter_;
     ScatterPlan plan_;
+    std::vector<double> kept_weight_, kept_inverse_distance_;  // per list entry of the rows [0, kept_rows_)
+    std::size_t kept_rows_ = 0;
 };
 
 }  // namespace gpa

@@ -219,6 +219,7 @@ void Simulation::Impl::reorder() {
 }
 
 void Simulation::Impl::move() {
+    neighbour_lists.forget_kept_pairs();  // kept at the old positions
     const int d = dim();
     const double dt = dt_half;
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, real, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
@@ -268,7 +269,11 @@ void Simulation::Impl::gradient() {
     f.alpha_limit = scene.solver.alpha_limit;
     f.full_normalisation = scene.solver.normalisation == Normalisation::MomentMatrix;
     f.allow_degenerate = true;  // a fragment that has lost its neighbours flies on (see fields.hpp)
+    const NeighbourLists::PairTerms kept = neighbour_lists.keep_pairs(real);  // for the sweeps after this one
+    f.keep_weight = kept.weight;
+    f.keep_inverse_distance = kept.inverse_distance;
     compute_velocity_gradient<G>(lists(), scene.solver.weight, f, real);
+    neighbour_lists.pairs_kept(std::min(real, lists().rows()));
 }
 
 template <class G>
@@ -363,7 +368,7 @@ void Simulation::Impl::time_step() {
 template <class G>
 void Simulation::Impl::forces() {
     auto f = force_fields<G::dim>(nodes, a());
-    f.pairs = contact.fields(f.pairs, nodes);
+    f.pairs = neighbour_lists.with_kept_pairs(contact.fields(f.pairs, nodes));
     f.hoop_count = real;
     f.full_normalisation = scene.solver.normalisation == Normalisation::MomentMatrix;
     BondViscosityParameters bond{scene.solver.viscosity_linear, scene.solver.viscosity_quadratic, scene.solver.bond_viscosity_eps0};
@@ -423,7 +428,7 @@ void Simulation::Impl::integrate(double dt_avg) {
     rigid_planes.book_friction(nodes, dt_avg);  // its work becomes heat of the nodes it acted on
     if (ledger.compatible() && particles) {
         auto f = force_fields<G::dim>(nodes, a());
-        f.pairs = contact.fields(f.pairs, nodes);
+        f.pairs = neighbour_lists.with_kept_pairs(contact.fields(f.pairs, nodes));
         f.full_normalisation = scene.solver.normalisation == Normalisation::MomentMatrix;
         if (scene.solver.viscosity != ViscosityKind::Nodal) f.viscous_pressure = nullptr;  // as in forces()
         std::optional<HourglassFields<G::dim>> control;
@@ -453,7 +458,7 @@ void Simulation::Impl::smoothing() {
     o.held = regions.held_bits();
     std::array<double*, G::dim> v{};
     for (int c = 0; c < G::dim; ++c) v[c] = nodes.velocity[c].data();
-    smooth_velocities<G>(lists(), plan(), scene.solver.weight, contact.fields(pair_fields<G::dim>(nodes, a()), nodes), real, o, v,
+    smooth_velocities<G>(lists(), plan(), scene.solver.weight, neighbour_lists.with_kept_pairs(contact.fields(pair_fields<G::dim>(nodes, a()), nodes)), real, o, v,
                          nodes.mass.data(), nodes.pressure.data(), nodes.internal_energy.data(), smoothing_scratch);
     regions.book_smoothing(G::dim, nodes.mass.data(), smoothing_scratch.total_change);
 }

@@ -7,6 +7,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 
 #include "gpa/engine/kernels.hpp"
 #include "gpa/engine/node_store.hpp"
@@ -84,6 +85,38 @@ struct PairFields {
         p.R = VariableWeight::value(lattice_pair(i, j) ? std::min(v, lattice_weight_reach) : v);
         return p;
     }
+
+    // The weights R_ij and inverse distances 1 / r_ij that this step's gradient sweep kept for the
+    // centres [0, kept_rows), one per entry of the lists (NeighbourLists::keep_pairs; entry k of
+    // row i is lists.offsets[i] + k). The sweeps after it in the same step (forces, stress power,
+    // smoothing) read them instead of making the square root, the two divisions and the weight
+    // again: positions and diameters do not change between the gradient and the end of the step,
+    // so they are the same numbers bit for bit.
+    const double* kept_weight = nullptr;
+    const double* kept_inverse_distance = nullptr;
+    std::size_t kept_rows = 0;
+
+    // pair<W>(i, j) of list entry `entry` of centre i, from the kept numbers where there are any.
+    // A kept pair has no r and h (NaN): a kernel that reads them (the bond viscosity, Eq. 38)
+    // calls pair(i, j).
+    template <class VariableWeight>
+    PairGeometry<D> pair(std::size_t i, std::size_t j, std::size_t entry) const {
+        if (i >= kept_rows) return pair<VariableWeight>(i, j);
+        PairGeometry<D> p;
+        Vec<D> dx;
+        for (int c = 0; c < D; ++c) dx[c] = position[c][j] - position[c][i];
+        p.inv_r = kept_inverse_distance[entry];
+        p.l = dx * p.inv_r;
+        p.r = p.h = std::numeric_limits<double>::quiet_NaN();
+        p.R = kept_weight[entry];
+        return p;
+    }
+
+    // R_ij alone (Eq. 1b or 62-65), of list entry `entry` of centre i.
+    template <class VariableWeight>
+    double weight(std::size_t i, std::size_t j, std::size_t entry) const {
+        return i < kept_rows ? kept_weight[entry] : pair<VariableWeight>(i, j).R;
+    }
 };
 
 template <int D>
@@ -102,6 +135,10 @@ struct GradientFields {
     double* smallest_h = nullptr;
     double* stable_length = nullptr;  // optional (kernels.hpp: stable_length)
     double alpha_limit = 0.0;         // > 0: alpha_b <= alpha_limit / W_i
+    // Optional, one per list entry of the centres swept: each pair's R_ij and 1 / r_ij, kept for
+    // the sweeps after the gradient (PairFields::kept_weight).
+    double* keep_weight = nullptr;
+    double* keep_inverse_distance = nullptr;
     // false: a centre without neighbours, or whose neighbours give no geometry factor along some
     // axis, is an error (InputError naming it). true (in a run, where fracture and spall leave
     // fragments): its factor along that axis is 0, so it has no strain rate and exerts no force
