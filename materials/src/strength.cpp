@@ -27,23 +27,22 @@ Sym3 to_sym3(const Eigen::Matrix3d& m) {
 // Von Mises equivalent stress sqrt(3/2 s:s) of a deviator s (materials.md, "Strength").
 double von_mises(const Eigen::Matrix3d& deviator) { return std::sqrt(1.5 * deviator.squaredNorm()); }
 
-// Johnson-Cook flow stress and hardening slope (materials.md, "Strength"):
-//   Y = (A + B eps_p^n)(1 + C ln(max(epsdot / epsdot0, 1)))(1 - T*^m),
-// with the edges guarded: eps_p^n = 0 at eps_p <= 0; the rate ratio floored at 1 so the rate term
-// never weakens the material; T* clamped to [0, 1]; Y = 0 at and above melt (T* >= 1).
-// dY/d eps_p = B n eps_p^(n - 1) (rate and thermal factors), infinite at eps_p = 0 when n < 1.
-FlowStress johnson_cook_flow(const JohnsonCookStrength& jc, double plastic_strain, double strain_rate,
-                             double homologous_temperature) {
-    const double t_star = std::clamp(homologous_temperature, 0.0, 1.0);
-    if (t_star >= 1.0) {
-        return {0.0, 0.0};
-    }
-    // pow(0, m) = 0 for m > 0 and ln(1) = 0: both calls are skipped where they give those (at
-    // room temperature and without plastic flow, most points of most steps).
-    const double thermal = t_star > 0.0 ? 1.0 - std::pow(t_star, jc.m) : 1.0;
-    const double rate_ratio = strain_rate / jc.reference_strain_rate;
-    const double rate = rate_ratio > 1.0 ? 1.0 + jc.c * std::log(rate_ratio) : 1.0;
+namespace {
 
+// The thermal factor 1 - T*^m for T* in [0, 1). pow(0, m) = 0: the call is skipped there (room
+// temperature, most points of most steps).
+double johnson_cook_thermal(const JohnsonCookStrength& jc, double t_star) {
+    return t_star > 0.0 ? 1.0 - std::pow(t_star, jc.m) : 1.0;
+}
+
+// The rate factor 1 + C ln(epsdot / epsdot0), the ratio floored at 1 (ln(1) = 0: no call there).
+double johnson_cook_rate(const JohnsonCookStrength& jc, double strain_rate) {
+    const double rate_ratio = strain_rate / jc.reference_strain_rate;
+    return rate_ratio > 1.0 ? 1.0 + jc.c * std::log(rate_ratio) : 1.0;
+}
+
+// Y and dY/d eps_p from the strain term and the two factors above.
+FlowStress johnson_cook_hardening(const JohnsonCookStrength& jc, double plastic_strain, double rate, double thermal) {
     double hardening = jc.a;
     double slope = 0.0;
     if (jc.b != 0.0 && jc.n > 0.0) {
@@ -58,6 +57,22 @@ FlowStress johnson_cook_flow(const JohnsonCookStrength& jc, double plastic_strai
         hardening += jc.b;  // n = 0: a step at eps_p = 0 (validate() only allows it with B = 0)
     }
     return {hardening * rate * thermal, slope * rate * thermal};
+}
+
+}  // namespace
+
+// Johnson-Cook flow stress and hardening slope (materials.md, "Strength"):
+//   Y = (A + B eps_p^n)(1 + C ln(max(epsdot / epsdot0, 1)))(1 - T*^m),
+// with the edges guarded: eps_p^n = 0 at eps_p <= 0; the rate ratio floored at 1 so the rate term
+// never weakens the material; T* clamped to [0, 1]; Y = 0 at and above melt (T* >= 1).
+// dY/d eps_p = B n eps_p^(n - 1) (rate and thermal factors), infinite at eps_p = 0 when n < 1.
+FlowStress johnson_cook_flow(const JohnsonCookStrength& jc, double plastic_strain, double strain_rate,
+                             double homologous_temperature) {
+    const double t_star = std::clamp(homologous_temperature, 0.0, 1.0);
+    if (t_star >= 1.0) {
+        return {0.0, 0.0};
+    }
+    return johnson_cook_hardening(jc, plastic_strain, johnson_cook_rate(jc, strain_rate), johnson_cook_thermal(jc, t_star));
 }
 
 namespace {
@@ -97,13 +112,16 @@ ReturnResult johnson_cook_return(const JohnsonCookStrength& jc, const Eigen::Mat
                                  double initial_flow_stress) {
     const double three_g = 3.0 * shear_modulus;
     const auto rate_of = [dt](double x) { return dt > 0.0 ? x / dt : 0.0; };
-    // Y and dY/dx at x: the strain slope plus the rate term's d/dx of C ln(x / (dt epsdot0)).
+    // Y and dY/dx at x (johnson_cook_flow): the strain slope plus the rate term's d/dx of
+    // C ln(x / (dt epsdot0)). The thermal factor does not change within the return, so it is taken
+    // once; the rate factor once per evaluation, for Y and for its slope.
+    const bool molten = t_star >= 1.0;
+    const double thermal = molten ? 0.0 : johnson_cook_thermal(jc, t_star);
     const auto flow = [&](double x) {
-        FlowStress y = johnson_cook_flow(jc, plastic_strain + x, rate_of(x), t_star);
-        if (x > 0.0 && rate_of(x) > jc.reference_strain_rate) {
-            const double rate_factor = 1.0 + jc.c * std::log(rate_of(x) / jc.reference_strain_rate);
-            y.slope += y.stress / rate_factor * jc.c / x;
-        }
+        if (molten) return FlowStress{0.0, 0.0};
+        const double rate = johnson_cook_rate(jc, rate_of(x));
+        FlowStress y = johnson_cook_hardening(jc, plastic_strain + x, rate, thermal);
+        if (x > 0.0 && rate_of(x) > jc.reference_strain_rate) y.slope += y.stress / rate * jc.c / x;
         return y;
     };
     double lo = 0.0;
