@@ -178,17 +178,13 @@ void GhostSet::update(NodeStore& nodes, std::size_t real_count) const {
             for (int c = 0; c < dim; ++c) {
                 nodes.position[c][g] = nodes.position[c][s];
                 nodes.velocity[c][g] = nodes.velocity[c][s];
+                nodes.initial_position[c][g] = nodes.initial_position[c][s];
             }
             for (std::size_t p = 0; p < planes_.size(); ++p) {
                 if (!((mask_[k] >> p) & 1u)) continue;
                 const int a = planes_[p].axis;
                 nodes.position[a][g] = 2.0 * planes_[p].position - nodes.position[a][g];
                 nodes.velocity[a][g] = -nodes.velocity[a][g];
-            }
-            for (int c = 0; c < dim; ++c) nodes.initial_position[c][g] = nodes.initial_position[c][s];
-            for (std::size_t p = 0; p < planes_.size(); ++p) {
-                if (!((mask_[k] >> p) & 1u)) continue;
-                const int a = planes_[p].axis;
                 nodes.initial_position[a][g] = 2.0 * planes_[p].position - nodes.initial_position[a][g];
             }
             nodes.mass[g] = nodes.mass[s];
