@@ -160,5 +160,46 @@ TEST(MemoryLimit, NeighbourListsAreCheckedBeforeASearchAllocatesThem) {
     EXPECT_NO_THROW(Simulation(scene, 1, MemoryLimit{bytes * 100, "a test limit"}));
 }
 
+TEST(MemoryLimit, RoomForTheListsButNotTheirKeptPairTermsRunsWithoutThemToTheSameNumbers) {
+    // Without a skin every step searches, and each search checks the limit with the nodes (ghosts
+    // included) and the entries of the lists it makes. The smallest limit that lets the lists of
+    // every step fit (bytes_per_list_entry) leaves no room for the terms a step keeps per pair
+    // (bytes_per_kept_pair): the run goes without them, its sweeps make them again, and the numbers
+    // are the same bit for bit.
+    auto scene = testing::armco_cylinder(10, 40e-6);
+    scene.solver.neighbour_skin = 0.0;
+    constexpr int steps = 40;
+    Simulation free(scene, 1);
+    const auto lists_bytes = [](const Simulation& sim, double per_entry) {
+        return double(sim.nodes().size()) * bytes_per_node_besides_lists(2) +
+               double(sim.neighbour_lists().offsets[sim.real_count()]) * per_entry;
+    };
+    double limit = lists_bytes(free, bytes_per_list_entry);
+    for (int k = 0; k < steps; ++k) {
+        free.step();
+        limit = std::max(limit, lists_bytes(free, bytes_per_list_entry));
+    }
+    // The last search has no room for the kept terms (else the test would show nothing).
+    ASSERT_LT(limit, lists_bytes(free, bytes_per_list_entry + bytes_per_kept_pair));
+    Simulation tight(scene, 1, MemoryLimit{static_cast<std::uint64_t>(std::ceil(limit)), "a test limit"});
+    for (int k = 0; k < steps; ++k) tight.step();
+    const auto kept_bytes = [](const Simulation& sim) {
+        for (const ArrayMemory& a : sim.memory_use()) {
+            if (a.array == "neighbour lists: kept pair terms") return a.bytes;
+        }
+        return std::size_t{0};
+    };
+    EXPECT_GT(kept_bytes(free), 0u);
+    EXPECT_EQ(kept_bytes(tight), 0u);
+    ASSERT_EQ(free.nodes().size(), tight.nodes().size());
+    for (std::size_t i = 0; i < free.real_count(); ++i) {
+        for (int c = 0; c < 2; ++c) {
+            ASSERT_EQ(free.nodes().position[c][i], tight.nodes().position[c][i]) << "node " << i;
+            ASSERT_EQ(free.nodes().velocity[c][i], tight.nodes().velocity[c][i]) << "node " << i;
+        }
+        ASSERT_EQ(free.nodes().internal_energy[i], tight.nodes().internal_energy[i]) << "node " << i;
+    }
+}
+
 }  // namespace
 }  // namespace gpa

@@ -60,6 +60,11 @@ void NeighbourLists::invalidate() {
 
 NeighbourLists::PairTerms NeighbourLists::keep_pairs(std::size_t real) {
     kept_rows_ = 0;
+    if (!keep_allowed_) {
+        std::vector<double>().swap(kept_weight_);
+        std::vector<double>().swap(kept_inverse_distance_);
+        return {nullptr, nullptr};
+    }
     const std::size_t entries = lists_.offsets[std::min(real, lists_.rows())];
     resize_with_slack(kept_weight_, entries);
     resize_with_slack(kept_inverse_distance_, entries);

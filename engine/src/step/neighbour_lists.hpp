@@ -36,8 +36,11 @@ public:
     // Set-up: `constant` when the lists can never change (every node fixed, one body, no ghosts):
     // then one search serves the whole run and there is no skin.
     void set_up(bool constant);
-    // Called with the entry count before every search allocates its lists (memory limits).
-    void set_entry_check(std::function<void(std::size_t)> check) { scratch_.check_entries = std::move(check); }
+    // Called with the entry count before every search allocates its lists (memory limits); it
+    // throws when the lists do not fit and returns whether the kept pair terms fit too.
+    void set_entry_check(std::function<bool(std::size_t)> check) {
+        scratch_.check_entries = [this, check = std::move(check)](std::size_t entries) { keep_allowed_ = check(entries); };
+    }
 
     const CompressedRows& rows() const { return lists_; }
 
@@ -45,13 +48,15 @@ public:
     // keep_pairs gives the gradient sweep arrays for the entries of the rows [0, real) to write,
     // pairs_kept says it has, and with_kept_pairs hands them to the sweeps after it. They are
     // forgotten when the positions move (forget_kept_pairs, the move phase) and when the lists
-    // change. Not checkpointed: every step makes them again before it reads them.
+    // change. Not checkpointed: every step makes them again before it reads them. When the memory
+    // limit leaves no room for them (set_entry_check), keep_pairs gives null pointers and the
+    // sweeps make the terms themselves.
     struct PairTerms {
         double* weight;
         double* inverse_distance;
     };
     PairTerms keep_pairs(std::size_t real);
-    void pairs_kept(std::size_t real) { kept_rows_ = real; }
+    void pairs_kept(std::size_t real) { kept_rows_ = keep_allowed_ ? real : 0; }
     void forget_kept_pairs() { kept_rows_ = 0; }
     template <int D>
     PairFields<D> with_kept_pairs(PairFields<D> pairs) const {
@@ -119,6 +124,7 @@ private:
     ScatterPlan plan_;
     std::vector<double> kept_weight_, kept_inverse_distance_;  // per list entry of the rows [0, kept_rows_)
     std::size_t kept_rows_ = 0;
+    bool keep_allowed_ = true;  // the memory limit leaves room for the kept pair terms
 };
 
 }  // namespace gpa

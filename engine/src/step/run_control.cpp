@@ -72,14 +72,16 @@ std::string describe_site(const FailureSite& f) {
 
 }  // namespace
 
-void RunControl::check_list_memory(const NodeStore& nodes, std::size_t real, std::size_t entries) const {
+bool RunControl::check_list_memory(const NodeStore& nodes, std::size_t real, std::size_t entries) const {
     const double bytes = double(nodes.size()) * bytes_per_node_besides_lists(nodes.dim()) + double(entries) * bytes_per_list_entry;
-    if (bytes > double(limit_bytes(memory_))) {
+    const double limit = double(limit_bytes(memory_));
+    if (bytes > limit) {
         throw LimitError(fmt::format("the neighbour lists would hold {} pairs ({:.3g} per node), an estimated {} of "
                                      "memory with the nodes; {}",
                                      entries, double(entries) / double(std::max<std::size_t>(real, 1)), format_bytes(bytes),
                                      describe_limit(memory_)));
     }
+    return bytes + double(entries) * bytes_per_kept_pair <= limit;
 }
 
 bool RunControl::finished(double time, std::size_t steps, const Totals& t, std::string& reason) const {

@@ -27,8 +27,9 @@ public:
     bool finished(double time, std::size_t steps, const Totals& totals, std::string& reason) const;
 
     // Throws LimitError when neighbour lists of `entries` pairs would not fit with the nodes in
-    // the memory limit (checked before a search allocates them).
-    void check_list_memory(const NodeStore& nodes, std::size_t real, std::size_t entries) const;
+    // the memory limit (checked before a search allocates them). Returns whether the terms kept per
+    // pair (bytes_per_kept_pair) fit as well.
+    bool check_list_memory(const NodeStore& nodes, std::size_t real, std::size_t entries) const;
 
     // The report of a phase that threw `e` during step steps + 1: the node the error names, else
     // the first real node with a value that is not a number.

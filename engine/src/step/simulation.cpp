@@ -596,7 +596,7 @@ Simulation::Simulation(Scene scene, int threads, MemoryLimit memory)
     validate_scene(impl_->scene);
     check_scene_memory(impl_->scene, memory);
     impl_->neighbour_lists.set_entry_check(
-        [im = impl_.get()](std::size_t entries) { im->run_control.check_list_memory(im->nodes, im->real, entries); });
+        [im = impl_.get()](std::size_t entries) { return im->run_control.check_list_memory(im->nodes, im->real, entries); });
     impl_->threads.run([this] {
         dispatch_geometry(impl_->scene.geometry, [this](auto g) { impl_->setup<decltype(g)>(); });
     });

@@ -30,9 +30,12 @@ std::string format_bytes(double bytes);
 // 3D 445 and about 200, and since issue 23 the 48 bytes of a 3D node's B).
 double bytes_per_node_besides_lists(int dim);
 // Memory per candidate pair of the neighbour lists: the candidate index (4 bytes), its keep
-// flag (1), and at most one entry of the cut lists (4) with its kept weight and inverse
-// distance (16; NeighbourLists::keep_pairs).
-constexpr double bytes_per_list_entry = 25.0;
+// flag (1) and its share of the cut lists (4).
+constexpr double bytes_per_list_entry = 9.0;
+// And per pair the terms a step keeps for its sweeps (R_ij and 1 / r_ij; NeighbourLists::keep_pairs).
+// A run whose lists fit the memory limit without them, but not with them, goes without them: its
+// forces, energy booking and smoothing then make those terms again, slower, to the same numbers.
+constexpr double bytes_per_kept_pair = 16.0;
 // Candidate pairs per node at the start of a run (skin 0.25, influence distance 1): about 21 in
 // 2D and 56 in 3D (docs/performance.md section 3).
 double list_entries_per_node(int dim);
