@@ -89,7 +89,7 @@ template <class G, class W, bool full>
 void gradient_impl(const CompressedRows& lists, const GradientFields<G::dim>& f, std::size_t n) {
     constexpr int D = G::dim;
     std::atomic<std::size_t> first_bad{no_node};
-    const bool keep = f.keep_weight != nullptr;
+    const bool keep = f.keep_weight != nullptr && f.keep_inverse_distance != nullptr;
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, row_grain), [&](const tbb::blocked_range<std::size_t>& range) {
         for (std::size_t i = range.begin(); i != range.end(); ++i) {
             const Vec<D> v_i = load<D>(f.velocity, i);

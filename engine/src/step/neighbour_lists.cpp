@@ -58,14 +58,23 @@ void NeighbourLists::invalidate() {
     kept_rows_ = 0;
 }
 
+void NeighbourLists::forget_kept_arrays() {
+    kept_rows_ = 0;
+    std::vector<double>().swap(kept_weight_);
+    std::vector<double>().swap(kept_inverse_distance_);
+}
+
 NeighbourLists::PairTerms NeighbourLists::keep_pairs(std::size_t real) {
     kept_rows_ = 0;
     if (!keep_allowed_) {
-        std::vector<double>().swap(kept_weight_);
-        std::vector<double>().swap(kept_inverse_distance_);
+        forget_kept_arrays();
         return {nullptr, nullptr};
     }
     const std::size_t entries = lists_.offsets[std::min(real, lists_.rows())];
+    if (entries > kept_weight_.capacity()) {  // grown: no copy of the old terms beside the new arrays
+        kept_weight_.clear();
+        kept_inverse_distance_.clear();
+    }
     resize_with_slack(kept_weight_, entries);
     resize_with_slack(kept_inverse_distance_, entries);
     return {kept_weight_.data(), kept_inverse_distance_.data()};
@@ -307,6 +316,7 @@ void NeighbourLists::write_state(StateWriter& out, int dim) const {
 }
 
 void NeighbourLists::read_state(StateReader& in, int dim, std::size_t node_count) {
+    kept_rows_ = 0;  // the restored lists are not those the terms were kept for
     in.tag("LIST");
     read_rows(in, lists_, std::numeric_limits<std::size_t>::max(), node_count);
     search_due_ = in.value<std::uint8_t>() != 0;

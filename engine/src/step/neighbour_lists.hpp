@@ -39,8 +39,13 @@ public:
     // Called with the entry count before every search allocates its lists (memory limits); it
     // throws when the lists do not fit and returns whether the kept pair terms fit too.
     void set_entry_check(std::function<bool(std::size_t)> check) {
-        scratch_.check_entries = [this, check = std::move(check)](std::size_t entries) { keep_allowed_ = check(entries); };
+        scratch_.check_entries = [this, check = std::move(check)](std::size_t entries) {
+            keep_allowed_ = check(entries);
+            if (!keep_allowed_) forget_kept_arrays();  // before the search allocates its lists
+        };
     }
+    NeighbourLists(const NeighbourLists&) = delete;  // the entry check above holds `this`
+    NeighbourLists& operator=(const NeighbourLists&) = delete;
 
     const CompressedRows& rows() const { return lists_; }
 
@@ -57,6 +62,7 @@ public:
     };
     PairTerms keep_pairs(std::size_t real);
     void pairs_kept(std::size_t real) { kept_rows_ = keep_allowed_ ? real : 0; }
+    void forget_kept_arrays();
     void forget_kept_pairs() { kept_rows_ = 0; }
     template <int D>
     PairFields<D> with_kept_pairs(PairFields<D> pairs) const {

@@ -90,8 +90,9 @@ struct PairFields {
     // centres [0, kept_rows), one per entry of the lists (NeighbourLists::keep_pairs; entry k of
     // row i is lists.offsets[i] + k). The sweeps after it in the same step (forces, stress power,
     // smoothing) read them instead of making the square root, the two divisions and the weight
-    // again: positions and diameters do not change between the gradient and the end of the step,
-    // so they are the same numbers bit for bit.
+    // again: positions, diameters, connectivity and bodies do not change between the gradient and
+    // the last of these sweeps (the switching phase comes after them), so they are the same numbers
+    // bit for bit.
     const double* kept_weight = nullptr;
     const double* kept_inverse_distance = nullptr;
     std::size_t kept_rows = 0;
