@@ -9,6 +9,7 @@
 #include <utility>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
@@ -33,6 +34,7 @@
 #include "gpa/engine/version.hpp"
 #include "step/contact.hpp"
 #include "step/energy_ledger.hpp"
+#include "step/external_loads.hpp"
 #include "step/neighbour_lists.hpp"
 #include "step/measures.hpp"
 #include "step/regions.hpp"
@@ -75,6 +77,7 @@ struct Simulation::Impl {
     double node_steps = 0.0;
     Regions regions;      // prescribed-velocity regions (step/regions.hpp)
     EnergyLedger ledger;  // every booking of work and heat (step/energy_ledger.hpp)
+    ExternalLoads external;  // an embedding program's forces and velocities between steps (step/external_loads.hpp)
     Totals totals;
     std::string stop_reason;
 
@@ -214,6 +217,7 @@ void Simulation::Impl::reorder() {
     const double cell = bulk_interaction_radius(nodes, a().value(), real);
     nodes.permute(locality_order(nodes, cell, 0, real));
     neighbour_lists.invalidate();  // rebuilt in the new numbering by the neighbours phase
+    external.forget_order();
     regroup_materials();
     regions.index(nodes, real);
 }
@@ -413,6 +417,7 @@ void Simulation::Impl::integrate(double dt_avg) {
     HeldNodes& held = regions.particles();
     if (!held.empty()) held.capture({velocity[0], velocity[1], velocity[2]}, d);
     ledger.keep_half_step_velocities(nodes);
+    if (external.forces_pending()) external.add_to_forces(nodes, real);  // a program's loads join the forces
     rigid_planes.apply_friction(ghosts, nodes, real, dt_avg);  // Coulomb friction joins the forces
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, real, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
         for (int c = 0; c < d; ++c) {
@@ -424,6 +429,7 @@ void Simulation::Impl::integrate(double dt_avg) {
     if (!held.empty()) {
         regions.book(held.impose(scene.prescribed_velocities, d, time + 0.5 * dt_next, dt_avg, velocity, nodes.mass.data()), dt_avg);
     }
+    if (external.forces_pending()) external.book(nodes, dt_avg);
     rigid_planes.add_impulses(dt_avg);
     rigid_planes.book_friction(nodes, dt_avg);  // its work becomes heat of the nodes it acted on
     if (ledger.compatible() && particles) {
@@ -494,7 +500,9 @@ void Simulation::Impl::sum_totals() {
     // a rigid motion's energy books close to round-off.
     const bool balance_at_half_step = ledger.compatible() && !elements;
     const double region_work_now = regions.report(time, balance_at_half_step, steps == 0 && time == 0.0, totals.regions);
-    totals.boundary_work = ledger.boundary_work() + element_boundary_work - region_work_now;
+    const double external_work_now = external.work(balance_at_half_step);
+    totals.external_work = external_work_now;
+    totals.boundary_work = ledger.boundary_work() + element_boundary_work - region_work_now - external_work_now;
     totals.momentum = all.momentum;
     totals.time = time;
     totals.time_step = dt_half;
@@ -523,7 +531,7 @@ void Simulation::Impl::sum_totals() {
     rigid_planes.report(ghosts, elements ? &elements->reactions() : nullptr, elements ? &elements->impulses() : nullptr,
                         totals.planes);
     measures.body_totals(scene, nodes, real, true, &s, totals.bodies);
-    totals.energy_given = totals.initial_energy + std::max(0.0, region_work_now);
+    totals.energy_given = totals.initial_energy + std::max(0.0, region_work_now + external_work_now);
     if (totals.energy_given != 0.0) {
         // With the compatible energy update the internal energy has been booked up to the velocities
         // of this half step, so the balance takes their kinetic energy (docs/energy.md); the mean of
@@ -661,6 +669,80 @@ double Simulation::element_steps() const { return impl_->element_steps; }
 const ElementPart* Simulation::elements() const { return impl_->elements.get(); }
 const CompressedRows& Simulation::neighbour_lists() const { return impl_->lists(); }
 
+// --- between steps ------------------------------------------------------------------------
+
+namespace {
+
+// A vector argument of the calls below: finite, and 0 beyond the scene's dimension.
+void check_vector(const std::array<double, 3>& v, int dim, const char* call, const char* what) {
+    for (int c = 0; c < 3; ++c) {
+        if (!std::isfinite(v[c])) throw InputError(fmt::format("Simulation::{}: its {} has a component that is not finite ({})", call, what, v[c]));
+        if (c >= dim && v[c] != 0.0) {
+            throw InputError(fmt::format("Simulation::{}: its {} has a third component ({}) in a 2D scene, whose components are "
+                                         "x (the radius in axisymmetric) and z",
+                                         call, what, v[c]));
+        }
+    }
+}
+
+}  // namespace
+
+std::size_t Simulation::index_of(std::uint64_t id) const { return impl_->external.index_of(impl_->nodes, impl_->real, id); }
+
+void Simulation::apply_force(std::uint64_t id, const std::array<double, 3>& force) {
+    Impl& im = *impl_;
+    if (im.failed) throw InputError("Simulation::apply_force: an earlier step failed");
+    check_vector(force, im.dim(), "apply_force", "force");
+    (void)im.external.index_of(im.nodes, im.real, id);
+    im.external.add_force(static_cast<std::uint32_t>(id), force);
+}
+
+void Simulation::set_velocity(std::uint64_t id, const std::array<double, 3>& velocity) {
+    Impl& im = *impl_;
+    if (im.failed) throw InputError("Simulation::set_velocity: an earlier step failed");
+    check_vector(velocity, im.dim(), "set_velocity", "velocity");
+    const std::size_t i = im.external.index_of(im.nodes, im.real, id);
+    if (const std::uint8_t region = im.nodes.velocity_region[i]; region != 0) {
+        throw InputError(fmt::format("Simulation::set_velocity: node id {} is held by the prescribed-velocity region \"{}\" "
+                                     "(set the region's velocity with set_region_velocity)",
+                                     id, im.scene.prescribed_velocities[region - 1u].name));
+    }
+    // The change of the half-step kinetic energy is work done on the bodies (external_loads.hpp).
+    double before = 0.0, after = 0.0;
+    for (int c = 0; c < im.dim(); ++c) {
+        before += im.nodes.velocity[c][i] * im.nodes.velocity[c][i];
+        after += velocity[c] * velocity[c];
+        im.nodes.velocity[c][i] = velocity[c];
+    }
+    im.external.add_work(0.5 * im.nodes.mass[i] * (after - before));
+}
+
+void Simulation::set_region_velocity(std::string_view name, const std::array<double, 3>& velocity) {
+    Impl& im = *impl_;
+    if (im.failed) throw InputError("Simulation::set_region_velocity: an earlier step failed");
+    auto& specs = im.scene.prescribed_velocities;
+    const auto it = std::find_if(specs.begin(), specs.end(), [&](const PrescribedVelocitySpec& r) { return r.name == name; });
+    if (it == specs.end()) {
+        std::vector<std::string> names;
+        for (const auto& r : specs) names.push_back("\"" + r.name + "\"");
+        throw InputError(fmt::format("Simulation::set_region_velocity: the scene has no prescribed-velocity region \"{}\" ({})", name,
+                                     names.empty() ? std::string("it has none") : fmt::format("it has {}", fmt::join(names, ", "))));
+    }
+    check_vector(velocity, im.dim(), "set_region_velocity", "velocity");
+    for (int c = 0; c < 3; ++c) {
+        if (!it->velocity[c] && velocity[c] != 0.0) {
+            throw InputError(fmt::format("Simulation::set_region_velocity: region \"{}\" leaves component {} free; it holds only the "
+                                         "components its scene gives",
+                                         name, "xyz"[im.dim() == 2 && c == 1 ? 2 : c]));
+        }
+    }
+    // From now on: the value replaces the scene's (and its ramp, which is over).
+    for (int c = 0; c < 3; ++c) {
+        if (it->velocity[c]) it->velocity[c] = velocity[c];
+    }
+    it->ramp = 0.0;
+}
+
 MemoryUse Simulation::memory_use() const {
     const Impl& im = *impl_;
     MemoryUse out;
@@ -728,12 +810,13 @@ void Simulation::Impl::write_state(StateWriter& out) const {
     measures.write_state(out);
     ledger.write_state(out);
     regions.write_state(out);
+    external.write_state(out, scene.prescribed_velocities);
     if (elements) elements->write_state(out);
     out.tag("TOTL");
     const Totals& t = totals;
     for (const double v : {t.time, t.time_step, t.kinetic_energy, t.internal_energy, t.plastic_work, t.viscous_work,
                            t.boundary_work, t.initial_kinetic_energy, t.initial_energy, t.energy_error, t.momentum[0],
-                           t.momentum[1], t.momentum[2], t.length, t.footprint_diameter, t.footprint_narrowest, t.footprint_widest, t.hourglass_work, t.hourglass_energy, t.energy_given}) {
+                           t.momentum[1], t.momentum[2], t.length, t.footprint_diameter, t.footprint_narrowest, t.footprint_widest, t.hourglass_work, t.hourglass_energy, t.energy_given, t.external_work}) {
         out.value<double>(v);
     }
     for (const std::size_t v : {t.step, t.real_nodes, t.ghost_nodes, t.variable_nodes, t.failed_nodes, t.pairs,
@@ -789,13 +872,14 @@ void Simulation::Impl::read_state(StateReader& in) {
     measures.read_state(in, scene.bodies.size());
     ledger.read_state(in);
     regions.read_state(in);
+    external.read_state(in, scene.prescribed_velocities);
     if (elements) elements->read_state(in);
     const std::size_t region_count = scene.prescribed_velocities.size();
     in.tag("TOTL");
     Totals& t = totals;
     for (double* v : {&t.time, &t.time_step, &t.kinetic_energy, &t.internal_energy, &t.plastic_work, &t.viscous_work,
                       &t.boundary_work, &t.initial_kinetic_energy, &t.initial_energy, &t.energy_error, &t.momentum[0],
-                      &t.momentum[1], &t.momentum[2], &t.length, &t.footprint_diameter, &t.footprint_narrowest, &t.footprint_widest, &t.hourglass_work, &t.hourglass_energy, &t.energy_given}) {
+                      &t.momentum[1], &t.momentum[2], &t.length, &t.footprint_diameter, &t.footprint_narrowest, &t.footprint_widest, &t.hourglass_work, &t.hourglass_energy, &t.energy_given, &t.external_work}) {
         *v = in.value<double>();
     }
     for (std::size_t* v : {&t.step, &t.real_nodes, &t.ghost_nodes, &t.variable_nodes, &t.failed_nodes, &t.pairs,

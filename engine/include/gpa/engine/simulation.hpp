@@ -91,7 +91,12 @@ struct Totals {
     double viscous_work = 0.0;     // work of artificial viscosity (nodal, bond and hourglass control), J
     double hourglass_work = 0.0;   // the part of viscous_work done by the hourglass control of fixed nodes, J
     double hourglass_energy = 0.0; // the part of internal_energy put in by the hourglass stiffness (solver.hourglass_stiffness), J
-    double boundary_work = 0.0;    // energy removed by velocity constraints (less the work of prescribed velocities), J
+    double boundary_work = 0.0;    // energy removed by velocity constraints (less the work of prescribed velocities
+                                   // and of a program's external forces and set velocities), J
+    // The work a program embedding the run has done on the bodies since t = 0 through
+    // Simulation::apply_force and set_velocity (at the instant of the balance's kinetic energy, as
+    // for the regions' work), J; part of boundary_work with the opposite sign.
+    double external_work = 0.0;
     double initial_kinetic_energy = 0.0;  // J
     double initial_energy = 0.0;   // kinetic + internal at t = 0, J
     // The energy the run was given: E0, plus the work of the prescribed velocities when they
@@ -201,6 +206,29 @@ public:
     // element bodies are not counted yet).
     MemoryUse memory_use() const;
 
+    // --- between steps: what a program that embeds gpa may do (docs/api.md) -------------------
+    // Particle nodes are addressed by id (NodeStore::id: 0, 1, ... in the order the scene's particle
+    // bodies were filled, fixed for the run), since their indices change when they are reordered.
+    // Vectors have the nodes' components: x, y, z in 3D; x (the radius in axisymmetric) and z in
+    // 2D, with the third entry 0. In axisymmetric scenes forces are ring totals, as the reactions
+    // are. Every call throws InputError with a message naming what is wrong (an id no particle
+    // node has, a vector that is not finite or has a third component in 2D, a held component).
+
+    // The index in nodes() of the particle node with this id now (valid until the next step).
+    std::size_t index_of(std::uint64_t id) const;
+    // Adds an external force (N) to the node for the next step only: it joins the internal forces
+    // in that step's velocity update. Its work, dt_avg F . (v^{n+1/2} + v^{n+3/2}) / 2, is booked
+    // (Totals::external_work) and the energy balance stays closed.
+    void apply_force(std::uint64_t id, const std::array<double, 3>& force);
+    // Sets the node's velocity (the half step ahead, v^{n+3/2}, with which the next step moves
+    // it); the change of its kinetic energy is booked as external work. A component held by a
+    // prescribed-velocity region cannot be set here (set_region_velocity).
+    void set_velocity(std::uint64_t id, const std::array<double, 3>& velocity);
+    // From the next step on, the region holds its components at this velocity (m/s; its ramp is
+    // over). Components the region leaves free must be 0. Its reaction and work are reported in
+    // Totals::regions as before.
+    void set_region_velocity(std::string_view name, const std::array<double, 3>& velocity);
+
     // --- checkpoints --------------------------------------------------------------------------
     // Writes everything later steps depend on (every node field, the ghosts, the neighbour lists
     // and their candidates with the positions and diameters of the last search, the scatter
@@ -223,7 +251,8 @@ public:
     // Reads the header of a checkpoint (no Simulation needed). Throws CheckpointError.
     static CheckpointInfo checkpoint_info(std::istream& in, std::uint64_t size, const std::string& source);
     // The format version save_checkpoint writes.
-    static constexpr std::uint32_t checkpoint_format = 6;  // 4: a section per part of the step; 5: element bodies; 6: B of 3D nodes
+    // 4: a section per part of the step; 5: element bodies; 6: B of 3D nodes; 7: external loads
+    static constexpr std::uint32_t checkpoint_format = 7;
 
 private:
     struct Impl;

@@ -1,0 +1,110 @@
+#include "step/external_loads.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "gpa/engine/errors.hpp"
+
+namespace gpa {
+
+std::size_t ExternalLoads::index_of(const NodeStore& nodes, std::size_t real, std::uint64_t id) {
+    if (index_of_id_.empty() && real > 0) {
+        const std::uint32_t largest = *std::max_element(nodes.id.begin(), nodes.id.begin() + static_cast<std::ptrdiff_t>(real));
+        index_of_id_.assign(std::size_t(largest) + 1, no_index);
+        for (std::size_t i = 0; i < real; ++i) index_of_id_[nodes.id[i]] = static_cast<std::uint32_t>(i);
+    }
+    if (id >= index_of_id_.size() || index_of_id_[id] == no_index) {
+        throw InputError(fmt::format("node id {}: no particle node has it (the ids of this run are 0 to {}, one per particle node "
+                                     "in the order the scene's bodies were filled)",
+                                     id, real == 0 ? 0 : real - 1));
+    }
+    return index_of_id_[id];
+}
+
+void ExternalLoads::add_force(std::uint32_t id, const std::array<double, 3>& force) {
+    const auto same = std::find_if(pending_.begin(), pending_.end(), [id](const Load& l) { return l.id == id; });
+    if (same == pending_.end()) {
+        pending_.push_back({id, force});
+    } else {
+        for (int c = 0; c < 3; ++c) same->force[c] += force[c];
+    }
+}
+
+void ExternalLoads::add_to_forces(NodeStore& nodes, std::size_t real) {
+    applied_to_.clear();
+    half_step_.clear();
+    const int dim = nodes.dim();
+    for (const Load& load : pending_) {
+        const std::size_t i = index_of(nodes, real, load.id);
+        applied_to_.push_back(i);
+        std::array<double, 3> v{0, 0, 0};
+        for (int c = 0; c < dim; ++c) {
+            v[c] = nodes.velocity[c][i];
+            nodes.force[c][i] += load.force[c];
+        }
+        half_step_.push_back(v);
+    }
+}
+
+void ExternalLoads::book(const NodeStore& nodes, double dt_avg) {
+    // dW = dt_avg F . (v^{n+1/2} + v^{n+3/2}) / 2 (the header), serial in the order the loads
+    // were given: the same sum on any thread count.
+    const int dim = nodes.dim();
+    double step_work = 0.0;
+    for (std::size_t k = 0; k < applied_to_.size(); ++k) {
+        const std::size_t i = applied_to_[k];
+        for (int c = 0; c < dim; ++c) step_work += dt_avg * pending_[k].force[c] * 0.5 * (half_step_[k][c] + nodes.velocity[c][i]);
+    }
+    work_ += step_work;
+    last_force_work_ = step_work;
+    pending_.clear();
+    applied_to_.clear();
+    half_step_.clear();
+}
+
+void ExternalLoads::write_state(StateWriter& out, const std::vector<PrescribedVelocitySpec>& regions) const {
+    out.tag("EXTL");
+    out.value<std::uint64_t>(pending_.size());
+    for (const Load& l : pending_) {
+        out.value<std::uint32_t>(l.id);
+        for (const double f : l.force) out.value<double>(f);
+    }
+    out.value<double>(work_);
+    out.value<double>(last_force_work_);
+    out.value<std::uint64_t>(regions.size());
+    for (const auto& r : regions) {
+        for (const auto& v : r.velocity) {
+            out.value<std::uint8_t>(v.has_value());
+            out.value<double>(v.value_or(0.0));
+        }
+        out.value<double>(r.ramp);
+    }
+}
+
+void ExternalLoads::read_state(StateReader& in, std::vector<PrescribedVelocitySpec>& regions) {
+    in.tag("EXTL");
+    const auto count = in.value<std::uint64_t>();
+    if (count > (std::uint64_t(1) << 32)) in.fail("its external loads are damaged");
+    pending_.assign(static_cast<std::size_t>(count), {});
+    for (Load& l : pending_) {
+        l.id = in.value<std::uint32_t>();
+        for (double& f : l.force) f = in.value<double>();
+    }
+    work_ = in.value<double>();
+    last_force_work_ = in.value<double>();
+    if (in.value<std::uint64_t>() != regions.size()) in.fail("its prescribed-velocity regions are not the scene's");
+    for (auto& r : regions) {
+        for (int c = 0; c < 3; ++c) {
+            const bool held = in.value<std::uint8_t>() != 0;
+            const double v = in.value<double>();
+            if (held != r.velocity[c].has_value()) in.fail(fmt::format("region \"{}\" holds other components than the scene's", r.name));
+            if (held) r.velocity[c] = v;
+        }
+        r.ramp = in.value<double>();
+    }
+    forget_order();
+}
+
+}  // namespace gpa
