@@ -18,8 +18,10 @@
 
 #include "gpa/engine/errors.hpp"
 #include "gpa/engine/simulation.hpp"
+#include "gpa/io/material_library.hpp"
 #include "gpa/io/output.hpp"
 #include "gpa/io/run_loop.hpp"
+#include "gpa/io/units.hpp"
 #include "support/scenes.hpp"
 
 namespace gpa {
@@ -184,6 +186,35 @@ TEST(Embedding, LoadsWaitingForTheNextStepAndRegionVelocitiesAreInTheCheckpoint)
     EXPECT_EQ(a.totals().regions[0].work, b.totals().regions[0].work);
 }
 
+// docs/api.md, "Building a scene in code", as written there.
+TEST(Embedding, TheApiPagesSceneBuiltInCodeRuns) {
+    using gpa::io::parse_quantity;
+    using gpa::io::Dimension;
+    gpa::Scene scene;
+    scene.name = "copper bar";
+    scene.geometry = gpa::GeometryKind::Axisymmetric;
+    scene.materials.push_back(gpa::io::builtin_material("OFHC copper"));
+    gpa::BodySpec bar;
+    bar.name = "bar";
+    bar.material = "OFHC copper";
+    bar.radius = parse_quantity("3.81 mm", Dimension::Length);
+    bar.length = parse_quantity("25.4 mm", Dimension::Length);
+    bar.spacing = parse_quantity("0.635 mm", Dimension::Length);
+    bar.velocity = {0.0, -parse_quantity("190 m/s", Dimension::Velocity), 0.0};
+    scene.bodies.push_back(bar);
+    gpa::PlaneSpec anvil;
+    anvil.name = "anvil";
+    scene.planes.push_back(anvil);
+    scene.stop.end_time = 80e-6;
+    gpa::Simulation sim(scene, /*threads=*/0);
+    for (int n = 0; n < 20; ++n) sim.step();
+    EXPECT_EQ(sim.real_count(), 6u * 40u);          // 3.81 / 0.635 across, 25.4 / 0.635 along
+    EXPECT_GT(sim.totals().planes.at(0).impulse, 0.0);  // it stands on the anvil
+    // A mistake in it is refused with the reader's words.
+    scene.bodies[0].spacing = -1.0;
+    EXPECT_NE(refusal_of([&] { gpa::Simulation bad(scene, 1); }).find("spacing"), std::string::npos);
+}
+
 // --- the run loop ------------------------------------------------------------------------------
 
 const fs::path tiny_scene = fs::path(GPA_SOURCE_DIR) / "tests" / "cli" / "tiny.toml";
@@ -297,6 +328,28 @@ TEST(RunLoopLibrary, AHookThatThrowsFailsTheRunAndKeepsWhatWasWritten) {
     EXPECT_FALSE(fs::exists(folder));  // not committed
     EXPECT_THROW((void)run.run(), std::logic_error);
     fs::remove_all(run.partial_folder());
+}
+
+TEST(RunLoopLibrary, WarningsGoToTheCallbackOrAreKept) {
+    io::SceneSource source = io::SceneSource::from_file(tiny_scene);
+    source.text += "\n[reference]\nelements = \"no-such.elements.toml\"\n";
+    const fs::path folder = scratch("warnings");
+    {
+        io::RunLoop kept(source, settings_for(folder));
+        ASSERT_EQ(kept.warnings().size(), 1u);
+        EXPECT_NE(kept.warnings()[0].find("no-such.elements.toml"), std::string::npos) << kept.warnings()[0];
+    }
+    std::vector<std::string> told;
+    io::RunSettings settings = settings_for(folder);
+    settings.warning = [&](const std::string& w) { told.push_back(w); };
+    io::RunLoop run(source, settings);
+    EXPECT_TRUE(run.warnings().empty());
+    ASSERT_EQ(told.size(), 1u);
+    EXPECT_NE(told[0].find("no-such.elements.toml"), std::string::npos);
+    ASSERT_EQ(run.run().status, io::RunStatus::Finished);
+    // The run goes on without the reference; its report is the run's.
+    EXPECT_NE(io::run_report(run.simulation()).find("20 steps"), std::string::npos);
+    fs::remove_all(folder);
 }
 
 TEST(RunLoopLibrary, RefusesARunWithoutAFolderAndASceneWithMistakesBeforeWritingAnything) {

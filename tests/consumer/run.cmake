@@ -1,4 +1,5 @@
-# Install gpa from BUILD_DIR into a scratch prefix, then build and run the consumer against it.
+# Install gpa from BUILD_DIR into a scratch prefix, then build and run the consumer and the
+# examples (examples/: run_scene on a small scene, coupled_support with its own checks) against it.
 file(REMOVE_RECURSE ${WORK_DIR})
 set(prefix ${WORK_DIR}/prefix)
 function(run)
@@ -12,3 +13,11 @@ run(${CMAKE_COMMAND} --install ${BUILD_DIR} --prefix ${prefix})
 run(${CMAKE_COMMAND} -S ${CONSUMER_SOURCE} -B ${WORK_DIR}/build -DCMAKE_PREFIX_PATH=${prefix} -DCMAKE_BUILD_TYPE=${CMAKE_BUILD_TYPE})
 run(${CMAKE_COMMAND} --build ${WORK_DIR}/build)
 run(${WORK_DIR}/build/consumer)
+
+run(${CMAKE_COMMAND} -S ${EXAMPLES_SOURCE} -B ${WORK_DIR}/examples -DCMAKE_PREFIX_PATH=${prefix} -DCMAKE_BUILD_TYPE=${CMAKE_BUILD_TYPE})
+run(${CMAKE_COMMAND} --build ${WORK_DIR}/examples)
+run(${WORK_DIR}/examples/run_scene ${SCENE} ${WORK_DIR}/run_scene_output)
+if(NOT EXISTS ${WORK_DIR}/run_scene_output/history.csv)
+  message(FATAL_ERROR "run_scene wrote no history.csv in ${WORK_DIR}/run_scene_output")
+endif()
+run(${WORK_DIR}/examples/coupled_support ${WORK_DIR}/coupled_support_output)
