@@ -18,6 +18,7 @@
 
 #include "gpa/engine/errors.hpp"
 #include "gpa/engine/simulation.hpp"
+#include "gpa/engine/state_io.hpp"
 #include "gpa/io/material_library.hpp"
 #include "gpa/io/output.hpp"
 #include "gpa/io/run_loop.hpp"
@@ -349,6 +350,32 @@ TEST(RunLoopLibrary, WarningsGoToTheCallbackOrAreKept) {
     ASSERT_EQ(run.run().status, io::RunStatus::Finished);
     // The run goes on without the reference; its report is the run's.
     EXPECT_NE(io::run_report(run.simulation()).find("20 steps"), std::string::npos);
+    fs::remove_all(folder);
+}
+
+TEST(RunLoopLibrary, ResumeRefusesAFolderWithoutACheckpointAndAnotherScene) {
+    const fs::path folder = scratch("resume");
+    fs::create_directories(folder.string() + ".partial");
+    try {
+        (void)io::RunLoop::resume(folder, std::nullopt, settings_for({}));
+        ADD_FAILURE() << "an empty folder was resumed";
+    } catch (const io::OutputError& e) {
+        EXPECT_NE(std::string(e.what()).find("there is nothing to resume"), std::string::npos) << e.what();
+    }
+    fs::remove_all(folder.string() + ".partial");
+    // A run stopped after 3 steps, resumed with a scene that is not its own.
+    {
+        io::RunLoop first(io::SceneSource::from_file(tiny_scene), settings_for(folder));
+        io::RunHooks hooks;
+        hooks.stop_requested = [&] { return first.simulation().steps() == 3 ? io::StopRequest{2, "the test"} : io::StopRequest{}; };
+        ASSERT_EQ(first.run(hooks).status, io::RunStatus::Interrupted);
+    }
+    io::SceneSource other = io::SceneSource::from_file(tiny_scene);
+    other.text += "\n# changed\n";
+    other.name = "changed tiny.toml";
+    EXPECT_THROW((void)io::RunLoop::resume(folder, other, settings_for({})), CheckpointError);
+    // The folder is as it was: its own scene still resumes it.
+    EXPECT_EQ(io::RunLoop::resume(folder, std::nullopt, settings_for({}))->run().status, io::RunStatus::Finished);
     fs::remove_all(folder);
 }
 
