@@ -14,10 +14,14 @@
 // the lag, which is first order in the time step: run at C_cfl 0.4 and 0.2, the mismatch must fall
 // by at least 1.6 (2 for a first-order error, less a margin for the changed impact), and stay below
 // 2 % of the energy exchanged at the finer step. gpa's own energy balance must close as usual.
+// And a coupled run stopped half-way and resumed from its checkpoint (the support's state saved
+// with it through RunHooks::checkpoint_data) must end exactly where the unbroken run ends.
 //
 //   usage: coupled_support OUTPUT_FOLDER
 #include <cmath>
 #include <cstdio>
+#include <cstring>
+#include <memory>
 #include <exception>
 #include <stdexcept>
 #include <string>
@@ -75,13 +79,23 @@ struct Outcome {
     std::size_t steps = 0;
 };
 
-Outcome run(const std::string& folder, double cfl) {
+// The support's state as bytes, for the run's checkpoints, and back.
+std::string save(const Support& s) { return std::string(reinterpret_cast<const char*>(&s), sizeof s); }
+Support restore(const std::string& bytes) {
+    if (bytes.size() != sizeof(Support)) throw std::runtime_error("the checkpoint holds no support state");
+    Support s;
+    std::memcpy(&s, bytes.data(), sizeof s);
+    return s;
+}
+
+// A run at C_cfl `cfl` in `folder`; with stop_at > 0 it is stopped after that step and resumed.
+Outcome run(const std::string& folder, double cfl, std::size_t stop_at = 0) {
     gpa::io::SceneSource source{std::string(scene_text) + "\n[solver]\ncfl = " + std::to_string(cfl) + "\n",
                                 "coupled_support's scene", "(coupled_support)", {}};
     gpa::io::RunSettings settings;
     settings.output = folder;
     settings.overwrite = true;
-    gpa::io::RunLoop loop(source, settings);
+    std::unique_ptr<gpa::io::RunLoop> loop = std::make_unique<gpa::io::RunLoop>(source, settings);
     Support support;
     gpa::io::RunHooks hooks;
     hooks.after_step = [&](gpa::Simulation& sim) {
@@ -96,9 +110,20 @@ Outcome run(const std::string& folder, double cfl) {
         support.work_received += dt_avg * -reaction * 0.5 * (before + support.velocity);
         sim.set_region_velocity("support", {0.0, support.velocity, 0.0});
     };
-    const gpa::io::RunResult result = loop.run(hooks);
+    hooks.checkpoint_data = [&] { return save(support); };
+    if (stop_at > 0) {
+        hooks.stop_requested = [&] {
+            return loop->simulation().steps() == stop_at ? gpa::io::StopRequest{1, "coupled_support"} : gpa::io::StopRequest{};
+        };
+        if (loop->run(hooks).status != gpa::io::RunStatus::Interrupted) throw std::runtime_error("the run was not stopped");
+        loop.reset();  // (the folder is locked while its loop exists)
+        loop = gpa::io::RunLoop::resume(folder, source, settings);
+        support = restore(loop->checkpoint_data());
+        hooks.stop_requested = nullptr;
+    }
+    const gpa::io::RunResult result = loop->run(hooks);
     if (result.status != gpa::io::RunStatus::Finished) throw std::runtime_error("the run did not finish: " + result.message);
-    const gpa::Totals& t = loop.simulation().totals();
+    const gpa::Totals& t = loop->simulation().totals();
     return {t.regions.at(0).work, support.work_received, t.energy_error, t.step};
 }
 
@@ -121,6 +146,16 @@ int main(int argc, char** argv) {
         }
         std::printf("mismatch falls by %.2f when the time step is halved\n", mismatch[0] / mismatch[1]);
         ok = ok && mismatch[0] >= 1.6 * mismatch[1] && mismatch[1] < 0.02;
+        const Outcome resumed = run(std::string(argv[1]) + "/cfl-0.4-resumed", 0.4, 200);
+        const bool same = resumed.steps == coarse.steps && resumed.plate_work == coarse.plate_work &&
+                          resumed.support_work == coarse.support_work && resumed.energy_error == coarse.energy_error;
+        std::printf("stopped after step 200 and resumed: %s the unbroken run (%.17g J/m)\n", same ? "the same as" : "NOT the same as",
+                    resumed.support_work);
+        if (!same) {
+            std::printf("  unbroken: %zu steps, %.17g, %.17g, %.17g\n  resumed:  %zu steps, %.17g, %.17g, %.17g\n", coarse.steps, coarse.plate_work,
+                        coarse.support_work, coarse.energy_error, resumed.steps, resumed.plate_work, resumed.support_work, resumed.energy_error);
+        }
+        ok = ok && same;
         std::printf("%s\n", ok ? "ok" : "FAILED");
         return ok ? 0 : 1;
     } catch (const std::exception& e) {

@@ -129,7 +129,32 @@ struct RunState {
     std::vector<PvdEntry> snapshots;  // the scheduled ones, in order
     HistoryWriter::Mark history;      // history.csv as it was (not recorded by older checkpoints)
     std::vector<GaugeWriter::Mark> gauges;  // each gauge_<name>.csv as it was, in the scene's gauge order
+    std::string program_data;  // RunHooks::checkpoint_data's bytes (any), hex-encoded in the file
 };
+
+std::string to_hex(const std::string& bytes) {
+    static constexpr char digits[] = "0123456789abcdef";
+    std::string out;
+    out.reserve(2 * bytes.size());
+    for (const unsigned char c : bytes) {
+        out += digits[c >> 4];
+        out += digits[c & 15];
+    }
+    return out;
+}
+
+std::string from_hex(const std::string& hex) {
+    if (hex.size() % 2 != 0) throw std::invalid_argument(hex);
+    const auto nibble = [](char c) {
+        if (c >= '0' && c <= '9') return c - '0';
+        if (c >= 'a' && c <= 'f') return c - 'a' + 10;
+        throw std::invalid_argument(std::string(1, c));
+    };
+    std::string out;
+    out.reserve(hex.size() / 2);
+    for (std::size_t k = 0; k < hex.size(); k += 2) out += static_cast<char>(nibble(hex[k]) * 16 + nibble(hex[k + 1]));
+    return out;
+}
 
 std::string encode(const RunState& s) {
     std::string scene = s.scene_file;
@@ -143,6 +168,7 @@ std::string encode(const RunState& s) {
     for (const auto& e : s.snapshots) out += fmt::format("snapshot={:.17g} {} {}\n", e.time, e.part, e.file);
     out += fmt::format("history={} {:016x}\n", s.history.bytes, s.history.digest);
     for (const auto& g : s.gauges) out += fmt::format("gauge={} {:016x}\n", g.bytes, g.digest);
+    if (!s.program_data.empty()) out += fmt::format("program_data={}\n", to_hex(s.program_data));
     return out;
 }
 
@@ -160,6 +186,7 @@ RunState decode(const std::string& text, const std::string& source) {
         try {
             if (key == "scene_file") s.scene_file = value;
             else if (key == "resolve_from") s.resolve_from = value;
+            else if (key == "program_data") s.program_data = from_hex(value);
             else if (key == "overwrite") s.overwrite = value == "1";
             else if (key == "wall_seconds") s.wall_seconds = std::stod(value);
             else if (key == "output_seconds") s.output_seconds = std::stod(value);
@@ -302,6 +329,7 @@ struct RunLoop::Impl {
     HistoryWriter::Mark scheduled_rows;  // history.csv as of its last row on the schedule (steps 0, every, ...)
     std::vector<GaugeWriter::Mark> scheduled_gauge_rows;  // the gauges' files as of the same row
     std::optional<std::size_t> resumed_at;  // the checkpoint's step, for a resumed run
+    std::function<std::string()> checkpoint_data;  // the run's RunHooks::checkpoint_data
     bool ran = false;
     std::vector<std::string> warnings;
 
@@ -357,6 +385,12 @@ struct RunLoop::Impl {
                                               file.string(), present ? "is not whole" : "is missing", e.time * 1e6, checkpoint));
             }
         }
+        // The disk the rest of the run needs, from the snapshots it lists (those of part 0 are the
+        // scheduled ones).
+        const auto scheduled_snapshots = static_cast<std::size_t>(
+            std::count_if(state.snapshots.begin(), state.snapshots.end(), [](const PvdEntry& e) { return e.part == 0; }));
+        check_disk(*sim, *schedule, folder->partial(),
+                   state.snapshots.empty() ? 0 : file_bytes(folder->partial() / state.snapshots.front().file), scheduled_snapshots);
         // The gauges' files are checked, then cut back, before the history is.
         gauges.emplace(folder->partial(), *sim, checkpoint_step, every, state.gauges, checkpoint);
         scheduled_gauge_rows = gauges->marks();
@@ -378,12 +412,7 @@ struct RunLoop::Impl {
             const bool stale = name == "summary.json" || name == "profile.csv" || entry.path().extension() == ".tmp";
             if ((snapshot && !kept) || stale) fs::remove(entry.path(), ec);
         }
-        snapshots->series().restore(state.snapshots, static_cast<std::size_t>(std::count_if(
-                                                         state.snapshots.begin(), state.snapshots.end(),
-                                                         [](const PvdEntry& e) { return e.part == 0; })));
-        check_disk(*sim, *schedule, folder->partial(),
-                   state.snapshots.empty() ? 0 : file_bytes(folder->partial() / state.snapshots.front().file),
-                   snapshots->series().scheduled());
+        snapshots->series().restore(state.snapshots, scheduled_snapshots);
     }
 
     RunResult run(const RunHooks& hooks) {
@@ -395,8 +424,14 @@ struct RunLoop::Impl {
         const std::size_t every = std::max<std::size_t>(scene.output.history_every, 1);
         auto last_checkpoint = std::chrono::steady_clock::now();
         StopRequest stop;
-        const auto progress = [&](bool last) {
-            if (hooks.progress) hooks.progress(*sim, last);
+        checkpoint_data = hooks.checkpoint_data;
+        // The progress display's last call, also when the run fails; what it throws then is dropped
+        // (the run's own failure is the one to report).
+        const auto last_progress = [&] {
+            try {
+                if (hooks.progress) hooks.progress(*sim, true);
+            } catch (...) {
+            }
         };
         try {
             while (!sim->finished()) {
@@ -422,16 +457,19 @@ struct RunLoop::Impl {
                     write_checkpoint(wall());
                     last_checkpoint = std::chrono::steady_clock::now();
                 }
-                progress(false);
+                if (hooks.progress) hooks.progress(*sim, false);
             }
-            progress(true);
+            if (hooks.progress) hooks.progress(*sim, true);
             snapshots->wait();
         } catch (const StepFailure& f) {
-            progress(true);
+            last_progress();
             return failed(f.what(), &f.site(), wall());
         } catch (const std::exception& e) {
-            progress(true);
+            last_progress();
             return failed(e.what(), nullptr, wall());
+        } catch (...) {
+            last_progress();
+            return failed("a hook threw an exception that is not a std::exception", nullptr, wall());
         }
         if (stop.code != 0) return interrupted(stop, wall());
         return finished(wall());
@@ -451,6 +489,7 @@ struct RunLoop::Impl {
     void write_checkpoint(double wall_seconds) {
         snapshots->wait();  // the series on disk is the one the checkpoint lists
         RunState s = state;
+        if (checkpoint_data) s.program_data = checkpoint_data();
         s.wall_seconds = wall_seconds;
         s.output_seconds = snapshots->seconds();
         s.snapshot_slot = schedule->last_slot();
@@ -630,6 +669,7 @@ const fs::path& RunLoop::partial_folder() const { return impl_->folder->partial(
 const fs::path& RunLoop::final_folder() const { return impl_->folder->final_path(); }
 bool RunLoop::resumed() const { return impl_->resumed_at.has_value(); }
 const std::vector<std::string>& RunLoop::warnings() const { return impl_->warnings; }
+const std::string& RunLoop::checkpoint_data() const { return impl_->state.program_data; }
 
 RunResult RunLoop::run(const RunHooks& hooks) {
     Impl& im = *impl_;

@@ -9,16 +9,26 @@
 
 namespace gpa {
 
-std::size_t ExternalLoads::index_of(const NodeStore& nodes, std::size_t real, std::uint64_t id) {
-    if (index_of_id_.empty() && real > 0) {
-        const std::uint32_t largest = *std::max_element(nodes.id.begin(), nodes.id.begin() + static_cast<std::ptrdiff_t>(real));
-        index_of_id_.assign(std::size_t(largest) + 1, no_index);
-        for (std::size_t i = 0; i < real; ++i) index_of_id_[nodes.id[i]] = static_cast<std::uint32_t>(i);
+bool ExternalLoads::map_ids(const NodeStore& nodes, std::size_t real) {
+    constexpr std::uint32_t unseen = UINT32_MAX;
+    index_of_id_.assign(real, unseen);
+    for (std::size_t i = 0; i < real; ++i) {
+        const std::uint32_t id = nodes.id[i];
+        if (id >= real || index_of_id_[id] != unseen) {
+            index_of_id_.clear();
+            return false;
+        }
+        index_of_id_[id] = static_cast<std::uint32_t>(i);
     }
-    if (id >= index_of_id_.size() || index_of_id_[id] == no_index) {
+    return true;
+}
+
+std::size_t ExternalLoads::index_of(std::uint64_t id) const {
+    if (id >= index_of_id_.size()) {
         throw InputError(fmt::format("node id {}: no particle node has it (the ids of this run are 0 to {}, one per particle node "
-                                     "in the order the scene's bodies were filled)",
-                                     id, real == 0 ? 0 : real - 1));
+                                     "in the order the scene's bodies were filled{})",
+                                     id, index_of_id_.empty() ? 0 : index_of_id_.size() - 1,
+                                     index_of_id_.empty() ? "; this run has none" : ""));
     }
     return index_of_id_[id];
 }
@@ -32,12 +42,12 @@ void ExternalLoads::add_force(std::uint32_t id, const std::array<double, 3>& for
     }
 }
 
-void ExternalLoads::add_to_forces(NodeStore& nodes, std::size_t real) {
+void ExternalLoads::add_to_forces(NodeStore& nodes) {
     applied_to_.clear();
     half_step_.clear();
     const int dim = nodes.dim();
     for (const Load& load : pending_) {
-        const std::size_t i = index_of(nodes, real, load.id);
+        const std::size_t i = index_of(load.id);
         applied_to_.push_back(i);
         std::array<double, 3> v{0, 0, 0};
         for (int c = 0; c < dim; ++c) {
@@ -64,6 +74,10 @@ void ExternalLoads::book(const NodeStore& nodes, double dt_avg) {
     half_step_.clear();
 }
 
+void ExternalLoads::memory_use(MemoryUse& out) const {
+    add_memory(out, "external loads: node ids", allocated_bytes(index_of_id_));
+}
+
 void ExternalLoads::write_state(StateWriter& out, const std::vector<PrescribedVelocitySpec>& regions) const {
     out.tag("EXTL");
     out.value<std::uint64_t>(pending_.size());
@@ -83,14 +97,19 @@ void ExternalLoads::write_state(StateWriter& out, const std::vector<PrescribedVe
     }
 }
 
-void ExternalLoads::read_state(StateReader& in, std::vector<PrescribedVelocitySpec>& regions) {
+void ExternalLoads::read_state(StateReader& in, std::vector<PrescribedVelocitySpec>& regions, std::size_t real) {
     in.tag("EXTL");
     const auto count = in.value<std::uint64_t>();
-    if (count > (std::uint64_t(1) << 32)) in.fail("its external loads are damaged");
+    constexpr std::uint64_t bytes_per_load = 4 + 3 * 8;
+    if (count > in.left() / bytes_per_load || count > real) in.fail("its external loads are damaged");
     pending_.assign(static_cast<std::size_t>(count), {});
     for (Load& l : pending_) {
         l.id = in.value<std::uint32_t>();
-        for (double& f : l.force) f = in.value<double>();
+        if (l.id >= real) in.fail("an external load names a node the scene does not have");
+        for (double& f : l.force) {
+            f = in.value<double>();
+            if (!std::isfinite(f)) in.fail("an external load is not finite");
+        }
     }
     work_ = in.value<double>();
     last_force_work_ = in.value<double>();
@@ -100,11 +119,12 @@ void ExternalLoads::read_state(StateReader& in, std::vector<PrescribedVelocitySp
             const bool held = in.value<std::uint8_t>() != 0;
             const double v = in.value<double>();
             if (held != r.velocity[c].has_value()) in.fail(fmt::format("region \"{}\" holds other components than the scene's", r.name));
+            if (held && !std::isfinite(v)) in.fail(fmt::format("region \"{}\" has a velocity that is not finite", r.name));
             if (held) r.velocity[c] = v;
         }
         r.ramp = in.value<double>();
+        if (!(r.ramp >= 0.0) || !std::isfinite(r.ramp)) in.fail(fmt::format("region \"{}\" has a ramp that is damaged", r.name));
     }
-    forget_order();
 }
 
 }  // namespace gpa

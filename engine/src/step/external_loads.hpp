@@ -21,6 +21,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "gpa/engine/memory_use.hpp"
 #include "gpa/engine/node_store.hpp"
 #include "gpa/engine/scene.hpp"
 #include "gpa/engine/state_io.hpp"
@@ -29,10 +30,12 @@ namespace gpa {
 
 class ExternalLoads {
 public:
-    // The index of the real node with this id now; the map is made again after the nodes were
-    // reordered or restored (forget_order). Throws InputError for an id no real node has.
-    std::size_t index_of(const NodeStore& nodes, std::size_t real, std::uint64_t id);
-    void forget_order() { index_of_id_.clear(); }
+    // Where each id is: made at the set-up and again whenever the nodes are reordered or restored.
+    // The ids of the real nodes are 0 ... real - 1, each once; false (and no map) when they are not.
+    bool map_ids(const NodeStore& nodes, std::size_t real);
+    void forget_ids() { index_of_id_.clear(); }
+    // The index of the real node with this id now. Throws InputError for an id no real node has.
+    std::size_t index_of(std::uint64_t id) const;
 
     // Adds F to the node's external force in the next velocity update (forces on one node add up).
     void add_force(std::uint32_t id, const std::array<double, 3>& force);
@@ -40,7 +43,7 @@ public:
 
     // In the velocity update, before it: the forces join the nodes' forces, and v^{n+1/2} of their
     // nodes is kept. After it (and the prescribed components): their work; then they are cleared.
-    void add_to_forces(NodeStore& nodes, std::size_t real);
+    void add_to_forces(NodeStore& nodes);
     void book(const NodeStore& nodes, double dt_avg);
 
     // Work done on the bodies outside the step (a velocity set between steps), J.
@@ -52,8 +55,12 @@ public:
 
     // The section also holds each region's velocity and ramp, which a program may have changed
     // (Simulation::set_region_velocity); read_state puts them back into `regions`.
+    void memory_use(MemoryUse& out) const;
+
     void write_state(StateWriter& out, const std::vector<PrescribedVelocitySpec>& regions) const;
-    void read_state(StateReader& in, std::vector<PrescribedVelocitySpec>& regions);
+    // The loads' ids are checked against `real` (the scene's node count); counts against what is
+    // left of the file.
+    void read_state(StateReader& in, std::vector<PrescribedVelocitySpec>& regions, std::size_t real);
 
 private:
     struct Load {
@@ -63,9 +70,8 @@ private:
     std::vector<Load> pending_;                    // in the order they were given, one per id
     std::vector<std::size_t> applied_to_;          // the node of each pending load, during the update
     std::vector<std::array<double, 3>> half_step_; // its v^{n+1/2}
-    std::vector<std::uint32_t> index_of_id_;       // id -> index of a real node (none: no_index)
+    std::vector<std::uint32_t> index_of_id_;       // id -> index of a real node
     double work_ = 0.0, last_force_work_ = 0.0;
-    static constexpr std::uint32_t no_index = UINT32_MAX;
 };
 
 }  // namespace gpa

@@ -51,6 +51,12 @@ public:
     // the two half steps; the half step now ahead is kept for the next call.
     double advance_kinetic(double half_step_now);
     double half_step_kinetic() const { return kinetic_half_; }
+    // A velocity set between steps (Simulation::set_velocity) changed the kinetic energy of the
+    // half step ahead by `change` in `body`: the mean the next step reports starts from it.
+    void add_to_half_step_kinetic(std::size_t body, double change) {
+        kinetic_half_ += change;
+        if (body < body_kinetic_half_.size()) body_kinetic_half_[body] += change;
+    }
     const std::vector<double>& body_half_step_kinetic() const { return body_kinetic_half_; }
 
     // Per body, the sums of node_sums (one reduction with a slot per body; bodies are few). A

@@ -73,6 +73,7 @@ std::vector<RegionStep> HeldNodes::impose(const std::vector<PrescribedVelocitySp
             if (regions[k].velocity[c]) target[c] = prescribed_velocity(regions[k], c, time);
         }
         RegionStep& step = out[k];
+        step.velocity = target;
         for (std::size_t e = nodes_.offsets[k]; e < nodes_.offsets[k + 1]; ++e) {
             const NodeIndex i = nodes_.indices[e];
             for (int c = 0; c < dim; ++c) {

@@ -74,11 +74,14 @@ void Regions::book(const std::vector<RegionStep>& step, double dt_avg) {
     last_ = step;
 }
 
-void Regions::advance_displacements(int dim, double time, double dt) {
+void Regions::advance_displacements(int dim, double dt) {
+    // The velocity the last update imposed, prescribed_velocity(spec, c, t^n + dt / 2), kept from it:
+    // the scene's time history, or what a program set after that update (set_region_velocity),
+    // which the nodes take only at the next update.
     for (std::size_t k = 0; k < displacement_.size(); ++k) {
         const auto& spec = (*specs_)[k];
         for (int c = 0; c < dim; ++c) {
-            if (spec.velocity[c]) displacement_[k][c] += dt * prescribed_velocity(spec, c, time + 0.5 * dt);
+            if (spec.velocity[c]) displacement_[k][c] += dt * last_[k].velocity[c];
         }
     }
 }
@@ -124,6 +127,7 @@ void Regions::write_state(StateWriter& out) const {
             out.value<double>(last_[k].reaction[c]);
             out.value<double>(impulse_[k][c]);
             out.value<double>(displacement_[k][c]);
+            out.value<double>(last_[k].velocity[c]);
         }
         out.value<double>(last_[k].work);
     }
@@ -139,6 +143,7 @@ void Regions::read_state(StateReader& in) {
             last_[k].reaction[c] = in.value<double>();
             impulse_[k][c] = in.value<double>();
             displacement_[k][c] = in.value<double>();
+            last_[k].velocity[c] = in.value<double>();
         }
         last_[k].work = in.value<double>();
     }

@@ -45,8 +45,8 @@ public:
 
     // One step's constraint (HeldNodes::impose): its work and, over dt_avg, its impulse.
     void book(const std::vector<RegionStep>& step, double dt_avg);
-    // The held nodes move with v^{n+1/2}, the velocity the last constraint set at t + dt / 2.
-    void advance_displacements(int dim, double time, double dt);
+    // The held nodes move with v^{n+1/2}, the velocity the last constraint set (at t + dt / 2).
+    void advance_displacements(int dim, double dt);
     // The momentum that smoothing would have moved into held components (and that the free nodes
     // got instead) comes from the regions (smoothing.hpp): total_change holds each node's velocity
     // change, dim per node.

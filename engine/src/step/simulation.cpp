@@ -174,6 +174,7 @@ void Simulation::Impl::setup() {
     if (particles && scene.solver.reorder_interval > 0) reorder();
     regroup_materials();
     regions.index(nodes, real);
+    external.map_ids(nodes, real);
     contact.set_up(real);
     neighbour_lists.set_up(!contact.separation() && ghosts.empty() && !needs_search(nodes, real) &&
                            !switching_part.any_automatic());
@@ -217,7 +218,7 @@ void Simulation::Impl::reorder() {
     const double cell = bulk_interaction_radius(nodes, a().value(), real);
     nodes.permute(locality_order(nodes, cell, 0, real));
     neighbour_lists.invalidate();  // rebuilt in the new numbering by the neighbours phase
-    external.forget_order();
+    external.map_ids(nodes, real);
     regroup_materials();
     regions.index(nodes, real);
 }
@@ -233,7 +234,7 @@ void Simulation::Impl::move() {
             for (std::size_t i = r.begin(); i != r.end(); ++i) x[i] = leapfrog_position(x[i], v[i], dt);
         }
     });
-    regions.advance_displacements(dim(), time, dt);
+    regions.advance_displacements(dim(), dt);
     time += dt;
     rigid_planes.guard_penetration(ghosts, nodes, real, ledger);  // spec section 7
 }
@@ -417,7 +418,7 @@ void Simulation::Impl::integrate(double dt_avg) {
     HeldNodes& held = regions.particles();
     if (!held.empty()) held.capture({velocity[0], velocity[1], velocity[2]}, d);
     ledger.keep_half_step_velocities(nodes);
-    if (external.forces_pending()) external.add_to_forces(nodes, real);  // a program's loads join the forces
+    if (external.forces_pending()) external.add_to_forces(nodes);  // a program's loads join the forces
     rigid_planes.apply_friction(ghosts, nodes, real, dt_avg);  // Coulomb friction joins the forces
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, real, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
         for (int c = 0; c < d; ++c) {
@@ -429,7 +430,7 @@ void Simulation::Impl::integrate(double dt_avg) {
     if (!held.empty()) {
         regions.book(held.impose(scene.prescribed_velocities, d, time + 0.5 * dt_next, dt_avg, velocity, nodes.mass.data()), dt_avg);
     }
-    if (external.forces_pending()) external.book(nodes, dt_avg);
+    external.book(nodes, dt_avg);  // (also when none waited: the last update's work is then 0)
     rigid_planes.add_impulses(dt_avg);
     rigid_planes.book_friction(nodes, dt_avg);  // its work becomes heat of the nodes it acted on
     if (ledger.compatible() && particles) {
@@ -553,7 +554,7 @@ void Simulation::Impl::build_phase_graph() {
         graph->add("element move", [this] {
             elements->move(dt_half);
             if (!particles) {
-                regions.advance_displacements(2, time, dt_half);
+                regions.advance_displacements(2, dt_half);
                 time += dt_half;
             }
         });
@@ -687,13 +688,13 @@ void check_vector(const std::array<double, 3>& v, int dim, const char* call, con
 
 }  // namespace
 
-std::size_t Simulation::index_of(std::uint64_t id) const { return impl_->external.index_of(impl_->nodes, impl_->real, id); }
+std::size_t Simulation::index_of(std::uint64_t id) const { return impl_->external.index_of(id); }
 
 void Simulation::apply_force(std::uint64_t id, const std::array<double, 3>& force) {
     Impl& im = *impl_;
     if (im.failed) throw InputError("Simulation::apply_force: an earlier step failed");
     check_vector(force, im.dim(), "apply_force", "force");
-    (void)im.external.index_of(im.nodes, im.real, id);
+    (void)im.external.index_of(id);
     im.external.add_force(static_cast<std::uint32_t>(id), force);
 }
 
@@ -701,20 +702,29 @@ void Simulation::set_velocity(std::uint64_t id, const std::array<double, 3>& vel
     Impl& im = *impl_;
     if (im.failed) throw InputError("Simulation::set_velocity: an earlier step failed");
     check_vector(velocity, im.dim(), "set_velocity", "velocity");
-    const std::size_t i = im.external.index_of(im.nodes, im.real, id);
+    const std::size_t i = im.external.index_of(id);
+    // A component a region holds keeps the region's velocity (set_region_velocity changes it).
     if (const std::uint8_t region = im.nodes.velocity_region[i]; region != 0) {
-        throw InputError(fmt::format("Simulation::set_velocity: node id {} is held by the prescribed-velocity region \"{}\" "
-                                     "(set the region's velocity with set_region_velocity)",
-                                     id, im.scene.prescribed_velocities[region - 1u].name));
+        const PrescribedVelocitySpec& spec = im.scene.prescribed_velocities[region - 1u];
+        for (int c = 0; c < im.dim(); ++c) {
+            if (spec.velocity[c] && velocity[c] != im.nodes.velocity[c][i]) {
+                throw InputError(fmt::format("Simulation::set_velocity: node id {} is held along {} by the prescribed-velocity "
+                                             "region \"{}\" (set the region's velocity with set_region_velocity)",
+                                             id, "xyz"[im.dim() == 2 && c == 1 ? 2 : c], spec.name));
+            }
+        }
     }
-    // The change of the half-step kinetic energy is work done on the bodies (external_loads.hpp).
+    // The change of the half-step kinetic energy is work done on the bodies (external_loads.hpp);
+    // the kinetic energy the next step reports is the mean of the changed half step and the next.
     double before = 0.0, after = 0.0;
     for (int c = 0; c < im.dim(); ++c) {
         before += im.nodes.velocity[c][i] * im.nodes.velocity[c][i];
         after += velocity[c] * velocity[c];
         im.nodes.velocity[c][i] = velocity[c];
     }
-    im.external.add_work(0.5 * im.nodes.mass[i] * (after - before));
+    const double change = 0.5 * im.nodes.mass[i] * (after - before);
+    im.external.add_work(change);
+    im.measures.add_to_half_step_kinetic(static_cast<std::size_t>(im.nodes.body[i]), change);
 }
 
 void Simulation::set_region_velocity(std::string_view name, const std::array<double, 3>& velocity) {
@@ -751,6 +761,7 @@ MemoryUse Simulation::memory_use() const {
     im.ghosts.memory_use(out);
     im.contact.memory_use(out);
     im.ledger.memory_use(out);
+    im.external.memory_use(out);
     im.switching_part.memory_use(out);
     add_memory(out, "forces: largest bond viscosity", allocated_bytes(im.largest_bond_q));
     const auto& s = im.smoothing_scratch;
@@ -850,6 +861,7 @@ void Simulation::Impl::write_state(StateWriter& out) const {
 }
 
 void Simulation::Impl::read_state(StateReader& in) {
+    external.forget_ids();  // until the nodes are read whole: no id is found in a half-read store
     in.tag("SIMU");
     nodes.read_state(in);
     if (in.value<std::uint64_t>() != real) in.fail("its bodies hold another number of nodes than the scene's");
@@ -872,7 +884,7 @@ void Simulation::Impl::read_state(StateReader& in) {
     measures.read_state(in, scene.bodies.size());
     ledger.read_state(in);
     regions.read_state(in);
-    external.read_state(in, scene.prescribed_velocities);
+    external.read_state(in, scene.prescribed_velocities, real);
     if (elements) elements->read_state(in);
     const std::size_t region_count = scene.prescribed_velocities.size();
     in.tag("TOTL");
@@ -920,6 +932,7 @@ void Simulation::Impl::read_state(StateReader& in) {
     for (std::size_t b = 0; b < body_kinetic.size(); ++b) totals.bodies[b].kinetic_energy = body_kinetic[b];
     // The held nodes in the checkpoint's numbering: the same count per region as the scene's.
     regions.check_restored(in, nodes, real);
+    if (!external.map_ids(nodes, real)) in.fail("its node ids are not those of the scene's nodes (a damaged checkpoint)");
 }
 
 bool Simulation::can_checkpoint() const { return true; }

@@ -60,6 +60,7 @@ std::uint8_t held_components(const PrescribedVelocitySpec& region);
 struct RegionStep {
     std::array<double, 3> reaction{0, 0, 0};  // sum of R over the nodes, per component (N; 0 where free)
     double work = 0.0;                        // sum of dW, J
+    std::array<double, 3> velocity{0, 0, 0};  // the velocity it imposed, v^{n+3/2} (m/s; 0 where free)
 };
 
 // The held nodes of one node set (the particle nodes or the element nodes), grouped by region.

@@ -222,10 +222,12 @@ public:
     void apply_force(std::uint64_t id, const std::array<double, 3>& force);
     // Sets the node's velocity (the half step ahead, v^{n+3/2}, with which the next step moves
     // it); the change of its kinetic energy is booked as external work. A component held by a
-    // prescribed-velocity region cannot be set here (set_region_velocity).
+    // prescribed-velocity region must keep its value (set_region_velocity changes it).
     void set_velocity(std::uint64_t id, const std::array<double, 3>& velocity);
-    // From the next step on, the region holds its components at this velocity (m/s; its ramp is
-    // over). Components the region leaves free must be 0. Its reaction and work are reported in
+    // The region holds its components at this velocity from now on (m/s; its ramp is over): the
+    // next step's velocity update gives the held nodes this velocity, and they move with it from
+    // the step after (the next step moves them with the velocity already imposed). Components the
+    // region leaves free must be 0. Its reaction, displacement and work are reported in
     // Totals::regions as before.
     void set_region_velocity(std::string_view name, const std::array<double, 3>& velocity);
 

@@ -15,10 +15,10 @@
 //
 // Errors before the first step are thrown (InputError for the scene, LimitError for memory and
 // disk, io::OutputError for the folder, CheckpointError on resume), with the messages `gpa run`
-// prints, and leave no folder behind (a resumed run's folder is left as it was). From the first
-// step on, run() returns a RunResult: a failed step, an output that could not be written or an
-// exception thrown by a hook is a RunStatus::Failed result, with what was written kept in the
-// folder.
+// prints, and leave no folder behind (a resumed run's folder is left as it was: it is checked, and
+// its disk estimated, before anything in it changes). From the first step on, run() returns a
+// RunResult: a failed step, an output that could not be written or an exception thrown by a hook
+// is a RunStatus::Failed result, with what was written kept in the folder.
 //
 // The ten-line program (examples/run_scene.cpp):
 //
@@ -80,8 +80,12 @@ struct RunHooks {
     std::function<void(Simulation&)> after_step;
     // After each step and its outputs, and once more at the end (progress display).
     std::function<void(const Simulation&, bool last)> progress;
-    // Asked before each step.
+    // Asked before each step (also before the first).
     std::function<StopRequest()> stop_requested;
+    // The program's own state, saved in every checkpoint the run writes (any bytes; a coupled
+    // model's state, say), and given back by RunLoop::checkpoint_data() when the run is resumed,
+    // so that a coupled run can continue bit for bit.
+    std::function<std::string()> checkpoint_data;
     // Warnings of the steps (fixed nodes switched because a lattice cell collapsed); without one
     // they go where RunSettings::warning sends the set-up's.
     std::function<void(const std::string&)> step_warning;
@@ -107,8 +111,9 @@ struct RunResult {
 class RunLoop {
 public:
     // A fresh run: parses the scene, resolves the files it names, builds the simulation, checks
-    // its gauges and takes the folder (fresh: refused if it is in use or holds a run, unless
-    // overwrite). Nothing is written yet.
+    // its gauges and takes the folder: locks it (<folder>.lock, until the RunLoop is destroyed),
+    // refuses it if it holds a run (unless overwrite) and makes <folder>.partial, empty (a stale
+    // one from a failed run without a checkpoint is cleared). The outputs are written by run().
     RunLoop(SceneSource source, RunSettings settings);
     // Continues the run stopped in `folder` (<folder> or <folder>.partial) from its checkpoint;
     // `scene`, when given, must be the scene the run started with (the folder's copy is used
@@ -129,6 +134,9 @@ public:
     bool resumed() const;
     // Warnings so far, when RunSettings::warning was not given.
     const std::vector<std::string>& warnings() const;
+    // A resumed run: what RunHooks::checkpoint_data gave when its checkpoint was written (empty
+    // for a fresh run, or when there was no such hook).
+    const std::string& checkpoint_data() const;
 
     // Writes the run's first outputs (or checks and cuts back a resumed run's), then steps until a
     // stop criterion of the scene is met, a hook asks to stop, or a step fails. Runs once: a
