@@ -645,10 +645,21 @@ std::unique_ptr<RunLoop> RunLoop::resume(const fs::path& folder_path, std::optio
     const RunState started = decode(info.user_data, checkpoint.string());
     const fs::path original = given ? im->source.file
                                     : fs::path(started.resolve_from.empty() ? started.scene_file : started.resolve_from);
-    if (!scene.element_reference.empty() && !original.empty() && fs::exists(original)) {
+    // Bodies of shape "surface" cannot run without their STL files, found from there too.
+    const bool surfaces = std::any_of(scene.bodies.begin(), scene.bodies.end(),
+                                      [](const BodySpec& b) { return b.shape == ShapeKind::Surface; });
+    std::error_code ec;
+    const bool original_there = !original.empty() && fs::exists(original, ec);
+    if (surfaces && !original_there) {
+        throw InputError(fmt::format("{}: its bodies' STL files are found beside the scene file the run started from, '{}', which "
+                                     "is not there: give that scene file with the folder to resume",
+                                     partial.string(), original.string()));
+    }
+    if ((surfaces || !scene.element_reference.empty()) && original_there) {
         try {
             im->resolve_files(scene, original);
         } catch (const InputError& e) {
+            if (surfaces) throw;
             im->warning(e.what());
         }
     }

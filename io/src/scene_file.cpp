@@ -1,4 +1,5 @@
 #include "gpa/io/scene_file.hpp"
+#include "gpa/io/stl.hpp"
 #include "gpa/io/reference.hpp"
 
 #include <array>
@@ -33,7 +34,7 @@ const std::vector<std::string_view> scene_keys{
 const std::vector<std::string_view> body_keys{
     "name",    "shape",     "material", "origin",         "size",         "radius",            "diameter",
     "length",  "spacing",   "spacing_z", "velocity",      "initial_stress", "connectivity",    "lattice_neighbours",
-    "discretisation", "inner_radius", "nose",
+    "discretisation", "inner_radius", "nose", "file", "unit",
 };
 const std::vector<std::string_view> plane_keys{"name", "kind", "axis", "position", "side", "lift_off", "friction",
                                                "static_friction"};
@@ -193,9 +194,14 @@ BodySpec read_body(const Reporter& reporter, const toml::table& table, std::size
                                                      {"plate", ShapeKind::Plate},
                                                      {"rectangle", ShapeKind::Rectangle},
                                                      {"box", ShapeKind::Box},
-                                                     {"sphere", ShapeKind::Sphere}});
-    if (!shape) r.fail_missing("shape", "cylinder, plate, rectangle, box or sphere");
+                                                     {"sphere", ShapeKind::Sphere},
+                                                     {"surface", ShapeKind::Surface}});
+    if (!shape) r.fail_missing("shape", "cylinder, plate, rectangle, box, sphere or surface");
     b.shape = *shape;
+    if (b.shape == ShapeKind::Surface && dim == 2) {
+        r.fail_at("shape", fmt::format("\"surface\" (a closed triangulated surface from an STL file) is a 3D shape; {} takes "
+                                       "cylinder, plate, rectangle or sphere", scene_phrase(geometry)));
+    }
     if (b.shape == ShapeKind::Box && dim == 2) {
         r.fail_at("shape", fmt::format("\"box\" is a 3D shape; {} takes cylinder, plate, rectangle or sphere",
                                        scene_phrase(geometry)));
@@ -218,7 +224,27 @@ BodySpec read_body(const Reporter& reporter, const toml::table& table, std::size
     }
 
     const std::string_view shape_name = name_of(b.shape);
-    if (is_round(b.shape)) {
+    if (b.shape == ShapeKind::Surface) {
+        for (const std::string_view key : {"radius", "diameter", "length", "size", "inner_radius", "nose"}) {
+            if (r.has(key)) r.fail_at(key, "does not apply to a surface (its STL file gives its shape)");
+        }
+        b.surface_file = r.required_string("file", "the STL file of the closed surface, relative to the scene file");
+        if (b.surface_file.empty()) r.fail_at("file", "is empty: give the STL file of the closed surface");
+        // The unit of the file's numbers: a length unit ("mm") or a length ("25.4 mm").
+        const std::string unit = r.required_string("unit", "the length unit of the STL file's numbers, e.g. \"mm\"");
+        std::optional<double> metres;
+        for (const std::string& text : {unit, "1 " + unit}) {
+            if (metres) break;
+            try {
+                metres = parse_quantity(text, D::Length);
+            } catch (const std::exception&) {
+            }
+        }
+        if (!metres || !(*metres > 0.0)) {
+            r.fail_at("unit", fmt::format("\"{}\" is not a length unit (m, mm, um, in, ...) nor a positive length", unit));
+        }
+        b.surface_unit = *metres;
+    } else if (is_round(b.shape)) {
         if (r.has("radius") && r.has("diameter")) r.fail_at("diameter", "give radius or diameter, not both");
         if (const auto radius = r.quantity("radius", D::Length, Limit::Positive)) {
             b.radius = *radius;
@@ -245,6 +271,11 @@ BodySpec read_body(const Reporter& reporter, const toml::table& table, std::size
         b.length = *length;
     } else if (b.shape == ShapeKind::Sphere && r.has("length")) {
         r.fail_at("length", "does not apply to a sphere (give radius or diameter)");
+    }
+    if (b.shape != ShapeKind::Surface) {
+        for (const std::string_view key : {"file", "unit"}) {
+            if (r.has(key)) r.fail_at(key, fmt::format("applies to a surface only (shape = \"surface\"), not a {}", shape_name));
+        }
     }
     if (r.has("inner_radius")) {
         if (b.shape != ShapeKind::Sphere) {
@@ -768,6 +799,19 @@ std::string read_scene_text(const std::filesystem::path& file) {
 }
 
 std::string resolve_scene_files(Scene& scene, const std::filesystem::path& scene_file) {
+    // The surfaces of bodies of shape "surface": read, checked and made ready for their inside test.
+    for (std::size_t k = 0; k < scene.bodies.size(); ++k) {
+        BodySpec& b = scene.bodies[k];
+        if (b.shape != ShapeKind::Surface || b.surface) continue;
+        const std::filesystem::path file = std::filesystem::path(b.surface_file).is_relative()
+                                               ? (scene_file.parent_path() / b.surface_file).lexically_normal()
+                                               : std::filesystem::path(b.surface_file);
+        try {
+            b.surface = std::make_shared<SurfaceInside>(std::make_shared<TriangleSurface>(read_stl(file, b.surface_unit)));
+        } catch (const InputError& e) {
+            throw InputError(fmt::format("{}: body[{}] \"{}\".file: {}", scene_file.string(), k, b.name, e.what()));
+        }
+    }
     if (scene.element_reference.empty()) return {};
     if (std::filesystem::path(scene.element_reference).is_relative()) {
         scene.element_reference = (scene_file.parent_path() / scene.element_reference).lexically_normal().string();

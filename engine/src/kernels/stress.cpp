@@ -53,7 +53,7 @@ void from_material(const MaterialPointFields& f, std::size_t i, const materials:
     }
 }
 
-constexpr std::size_t no_node = std::numeric_limits<std::size_t>::max();
+constexpr std::size_t no_collapsed_node = std::numeric_limits<std::size_t>::max();
 
 }  // namespace
 
@@ -118,7 +118,7 @@ template <class G>
 void update_stresses(NodeStore& nodes, std::size_t real_count, const std::vector<materials::Material>& materials,
                      const std::vector<std::vector<NodeIndex>>& groups, double dt, const StressPhaseOptions& options) {
     constexpr int D = G::dim;
-    std::atomic<std::size_t> collapsed{no_node};
+    std::atomic<std::size_t> collapsed{no_collapsed_node};
     FirstPointFailure failure;  // taken only when a point update reports a fault
     const MaterialPointFields fields = material_point_fields(nodes, stress_components(nodes.dim()));
     for (std::size_t m = 0; m < groups.size(); ++m) {
@@ -183,7 +183,7 @@ void update_stresses(NodeStore& nodes, std::size_t real_count, const std::vector
                                          materials.at(static_cast<std::size_t>(nodes.material[i])).name, dt, failure.message()),
                              i, "stress (material point update)");
     }
-    if (const std::size_t i = collapsed.load(); i != no_node) {
+    if (const std::size_t i = collapsed.load(); i != no_collapsed_node) {
         throw NumericalError(fmt::format(
             "node {} at ({:.6g}, {:.6g}) m collapsed: its volume would become {:.3g} m^3 (volumetric strain "
             "rate {:.3g} 1/s over dt = {:.3g} s); the time step is too large or the node was crushed",

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 
 #include <fmt/format.h>
 
@@ -79,6 +80,8 @@ LatticeBlock body_lattice(const Scene& scene, std::size_t index) {
             }
             case ShapeKind::Box:
                 throw InputError(fmt::format("body \"{}\": a box is a 3D shape; use a rectangle in 2D", b.name));
+            case ShapeKind::Surface:
+                throw InputError(fmt::format("body \"{}\": a surface is a 3D shape", b.name));
         }
     } else {
         switch (b.shape) {
@@ -122,6 +125,31 @@ LatticeBlock body_lattice(const Scene& scene, std::size_t index) {
             }
             case ShapeKind::Rectangle:
                 throw InputError(fmt::format("body \"{}\": a rectangle is a 2D shape; use a box in 3D", b.name));
+            case ShapeKind::Surface: {
+                // The cells of the spacing as given, from the lower corner of the surface's box (moved
+                // by the origin), across its extent; those whose centre is inside are filled.
+                if (!b.surface) {
+                    throw InputError(fmt::format("body \"{}\": its surface (file \"{}\") has not been read: read the scene with "
+                                                 "io::load_scene, or call io::resolve_scene_files",
+                                                 b.name, b.surface_file));
+                }
+                const std::shared_ptr<const SurfaceInside> inside = b.surface;
+                const double s = b.spacing;
+                block.origin = {o[0] + inside->lower()[0], o[1] + inside->lower()[1], o[2] + inside->lower()[2]};
+                block.spacing = {s, s, s};
+                for (int c = 0; c < 3; ++c) {
+                    const double cells = std::ceil((inside->upper()[c] - inside->lower()[c]) / s - 1e-9);
+                    if (!(cells >= 1.0) || cells > 1e7) {
+                        throw InputError(fmt::format("body \"{}\": its surface needs {} lattice cells along axis {} at spacing {} m",
+                                                     b.name, cells, c, s));
+                    }
+                    block.last[static_cast<std::size_t>(c)] = static_cast<std::int64_t>(cells);
+                }
+                block.inside = [inside, o](const std::array<double, 3>& p) {
+                    return inside->inside({p[0] - o[0], p[1] - o[1], p[2] - o[2]});
+                };
+                break;
+            }
         }
     }
     // A symmetry plane through the body keeps the cells on its side (a half or quarter model). It

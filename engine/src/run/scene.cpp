@@ -60,10 +60,15 @@ bool known_shape(ShapeKind s) {
         case ShapeKind::Plate:
         case ShapeKind::Rectangle:
         case ShapeKind::Box:
-        case ShapeKind::Sphere: return true;
+        case ShapeKind::Sphere:
+        case ShapeKind::Surface: return true;
     }
     return false;
 }
+
+// Whether a body's shape is known: a surface before its file is read is not (a scene reader checks
+// the scene before it reads the files; the checks of its extent wait for the Simulation's).
+bool shape_known(const BodySpec& b) { return b.shape != ShapeKind::Surface || b.surface != nullptr; }
 
 // The interval a body occupies along an axis (before any node is placed).
 std::pair<double, double> extent(const BodySpec& b, GeometryKind g, int axis) {
@@ -81,6 +86,10 @@ std::pair<double, double> extent(const BodySpec& b, GeometryKind g, int axis) {
             return {o - b.radius, o + b.radius};
         case ShapeKind::Rectangle:
         case ShapeKind::Box: return {o, o + b.size[static_cast<std::size_t>(axis)]};
+        case ShapeKind::Surface: {
+            if (!b.surface) return {o, o};
+            return {o + b.surface->lower()[static_cast<std::size_t>(axis)], o + b.surface->upper()[static_cast<std::size_t>(axis)]};
+        }
     }
     return {o, o};
 }
@@ -116,6 +125,8 @@ bool inside_shape(const BodySpec& b, GeometryKind g, const std::array<double, 3>
                 if (!(p[c] > o[c] && p[c] < o[c] + b.size[c])) return false;
             }
             return true;
+        case ShapeKind::Surface:
+            return b.surface && b.surface->inside({p[0] - o[0], p[1] - o[1], p[2] - o[2]});
     }
     return false;
 }
@@ -130,6 +141,7 @@ void check_overlap(const Scene& scene, std::size_t a, std::size_t b) {
     const int dim = dimension_of(g);
     const BodySpec& first = scene.bodies[a];
     const BodySpec& second = scene.bodies[b];
+    if (!shape_known(first) || !shape_known(second)) return;
     std::array<double, 3> lo{}, hi{};
     for (int k = 0; k < dim; ++k) {
         const auto [lo_a, hi_a] = extent(first, g, k);
@@ -227,7 +239,12 @@ void check_body(const Scene& scene, const BodySpec& b, std::size_t i) {
     }
 
     // Sizes.
-    if (is_round(b.shape)) {
+    if (b.shape == ShapeKind::Surface) {
+        if (dim != 3) fail(fmt::format("{}: a surface is a 3D shape (a closed triangulated surface)", label));
+        // (A scene reader checks the scene before it reads the surface files: body_lattice refuses a
+        // body whose surface is still missing when its nodes are made.)
+        if (b.surface) check_surface(b.surface->triangles(), fmt::format("{}.file \"{}\"", label, b.surface_file));
+    } else if (is_round(b.shape)) {
         if (!(b.radius > 0.0 && finite(b.radius))) {
             fail(fmt::format("{}.radius = {} must be a positive length (m)", label, b.radius));
         }
@@ -306,7 +323,7 @@ void check_body(const Scene& scene, const BodySpec& b, std::size_t i) {
     if (!(b.spacing_z >= 0.0 && finite(b.spacing_z))) {
         fail(fmt::format("{}.spacing_z = {} must be a positive length (m), or 0 for the same as spacing", label, b.spacing_z));
     }
-    for (int k = 0; k < dim; ++k) {
+    for (int k = 0; k < dim && shape_known(b); ++k) {
         const auto [lo, hi] = extent(b, g, k);
         const double across = hi - lo;
         const double d = spacing_along(b, g, k);
@@ -389,6 +406,7 @@ void check_plane(const Scene& scene, const PlaneSpec& p, std::size_t i) {
     }
     for (std::size_t k = 0; k < scene.bodies.size(); ++k) {
         const BodySpec& b = scene.bodies[k];
+        if (!shape_known(b)) continue;
         const auto [lo, hi] = extent(b, g, p.axis);
         const double tolerance = 1e-9 * std::max(b.spacing, std::abs(p.position));
         if (symmetry_plane_cuts(scene, k, i)) {
@@ -515,6 +533,12 @@ bool any_initial_node(const Scene& scene, std::size_t b, const std::array<double
 // The largest distance of a body's points from its axis (prescribed.hpp, body_axis).
 double largest_radius(const BodySpec& b, GeometryKind g) {
     if (is_round(b.shape)) return b.radius;
+    if (b.shape == ShapeKind::Surface) {
+        // (3D only) half the diagonal of its box across z, from the box's centre line.
+        const auto [x0, x1] = extent(b, g, 0);
+        const auto [y0, y1] = extent(b, g, 1);
+        return 0.5 * std::hypot(x1 - x0, y1 - y0);
+    }
     if (g == GeometryKind::Axisymmetric) return b.origin[0] + b.size[0];
     if (g == GeometryKind::PlaneStrain) return 0.5 * b.size[0];
     return 0.5 * std::hypot(b.size[0], b.size[1]);
@@ -574,8 +598,8 @@ void check_prescribed_velocity(const Scene& scene, std::size_t k) {
     }
     const BodySpec& spec = *body;
     std::string spans;
-    bool outside = r.radius_min > largest_radius(spec, g) * (1.0 + 1e-12);
-    for (int c = 0; c < dim; ++c) {
+    bool outside = shape_known(spec) && r.radius_min > largest_radius(spec, g) * (1.0 + 1e-12);
+    for (int c = 0; c < dim && shape_known(spec); ++c) {
         const auto [lo, hi] = extent(spec, g, c);
         spans += fmt::format("{}{} from {:.6g} to {:.6g} mm", c ? ", " : "", axis_letter(c, dim), lo * 1e3, hi * 1e3);
         const double tolerance = 1e-9 * std::max(spec.spacing, std::max(std::abs(lo), std::abs(hi)));
@@ -642,6 +666,7 @@ std::string_view name_of(ShapeKind s) {
         case ShapeKind::Rectangle: return "rectangle";
         case ShapeKind::Box: return "box";
         case ShapeKind::Sphere: return "sphere";
+        case ShapeKind::Surface: return "surface";
     }
     return "?";
 }
@@ -707,7 +732,12 @@ std::vector<std::string> scene_warnings(const Scene& scene) {
             smallest = std::min(smallest, e);
             largest = std::max(largest, e);
         };
-        if (is_round(b.shape)) {
+        if (b.shape == ShapeKind::Surface) {
+            for (int c = 0; c < dim; ++c) {
+                const auto [lo, hi] = gpa::extent(b, scene.geometry, c);
+                extent(hi - lo);
+            }
+        } else if (is_round(b.shape)) {
             extent(2.0 * b.radius);
             if (b.shape != ShapeKind::Sphere) extent(b.length);
         } else {
@@ -763,6 +793,7 @@ std::optional<SymmetrySpan> symmetry_span(const Scene& scene, std::size_t body, 
     const PlaneSpec& p = scene.planes[plane];
     if (p.kind != PlaneKind::Symmetry || p.axis < 0 || p.axis >= dim || !finite(p.position)) return std::nullopt;
     const BodySpec& b = scene.bodies[body];
+    if (!shape_known(b)) return std::nullopt;
     const auto [lo, hi] = extent(b, scene.geometry, p.axis);
     return SymmetrySpan{lo, hi, p.position, 1e-9 * std::max(b.spacing, std::abs(p.position))};
 }

@@ -9,6 +9,10 @@ std::array<double, 2> body_axis(const Scene& scene, std::size_t body) {
     const BodySpec& b = scene.bodies.at(body);
     if (scene.geometry == GeometryKind::Axisymmetric) return {0.0, 0.0};
     if (is_round(b.shape)) return {b.origin[0], b.origin[1]};
+    if (b.shape == ShapeKind::Surface && b.surface) {  // the centre line of its box
+        return {b.origin[0] + 0.5 * (b.surface->lower()[0] + b.surface->upper()[0]),
+                b.origin[1] + 0.5 * (b.surface->lower()[1] + b.surface->upper()[1])};
+    }
     return {b.origin[0] + 0.5 * b.size[0], scene.geometry == GeometryKind::ThreeD ? b.origin[1] + 0.5 * b.size[1] : 0.0};
 }
 

@@ -9,6 +9,7 @@
 #include <cstddef>
 #include <limits>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -19,6 +20,7 @@
 #include "gpa/engine/gauges.hpp"
 #include "gpa/engine/geometry.hpp"
 #include "gpa/engine/snapshot_fields.hpp"
+#include "gpa/engine/surface.hpp"
 #include "gpa/engine/weights.hpp"
 #include "gpa/materials/material.hpp"
 
@@ -50,6 +52,7 @@ enum class ShapeKind {
     Rectangle,  // 2D: x in (x0, x0 + size_x), z in (z0, z0 + size_z)
     Box,        // 3D: a box from origin to origin + size
     Sphere,     // centre `origin`, `radius` (a disc in plane strain; a sphere on the axis in axisymmetric)
+    Surface,    // 3D: the inside of a closed triangulated surface (BodySpec::surface), moved by `origin`
 };
 
 // The scene-file word of a shape ("cylinder", ...), and whether it is round (has a radius).
@@ -103,6 +106,13 @@ struct BodySpec {
     double inner_radius = 0.0;
     double length = 0.0;                  // cylinder/plate, along z (a nose included)
     std::optional<NoseSpec> nose;         // cylinder only: its shaped end; none = flat ends
+    // Surface only: the file it was read from, as the scene names it (io::resolve_scene_files reads
+    // it, relative to the scene file's folder), the length unit of the file's numbers in metres,
+    // and the surface with its inside test, in metres before the body's origin is added (null until
+    // it is read).
+    std::string surface_file;
+    double surface_unit = 1.0;
+    std::shared_ptr<const SurfaceInside> surface;
     double spacing = 0.0;                 // lattice spacing dx (and dy, dz in 3D)
     double spacing_z = 0.0;               // 2D: dz; 0 = equal to dx
     std::string material;                 // a name in Scene::materials

@@ -1,0 +1,208 @@
+// STL files (io/stl.hpp) and bodies of shape "surface" in scene files: the binary and ASCII forms
+// of one cube read to the same surface in the unit given; cut-short, malformed and open files are
+// refused naming the file (and the line); a scene's surface file is found beside the scene and
+// fills the nodes of the box of the same size; the scene reader's refusals name the key.
+
+#include <algorithm>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+
+#include "gpa/engine/errors.hpp"
+#include "gpa/engine/simulation.hpp"
+#include "gpa/io/scene_file.hpp"
+#include "gpa/io/stl.hpp"
+
+namespace gpa::io {
+namespace {
+
+namespace fs = std::filesystem;
+using Corner = std::array<float, 3>;
+
+// The 12 outward triangles of the cube [0, a]^3, as corner triples.
+std::vector<std::array<Corner, 3>> cube_facets(float a) {
+    std::vector<std::array<Corner, 3>> out;
+    const auto corner = [a](int k) { return Corner{(k & 1) * a, ((k >> 1) & 1) * a, ((k >> 2) & 1) * a}; };
+    const int faces[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+    for (const auto& f : faces) {
+        out.push_back({corner(f[0]), corner(f[1]), corner(f[2])});
+        out.push_back({corner(f[0]), corner(f[2]), corner(f[3])});
+    }
+    return out;
+}
+
+std::string ascii_stl(const std::vector<std::array<Corner, 3>>& facets) {
+    std::string out = "solid cube\n";
+    for (const auto& f : facets) {
+        out += "  facet normal 0 0 0\n    outer loop\n";
+        for (const auto& c : f) out += fmt::format("      vertex {} {} {}\n", c[0], c[1], c[2]);
+        out += "    endloop\n  endfacet\n";
+    }
+    return out + "endsolid cube\n";
+}
+
+std::string binary_stl(const std::vector<std::array<Corner, 3>>& facets) {
+    std::string out(80, ' ');
+    out.replace(0, 11, "solid cube ");  // a binary header may begin like an ASCII file
+    const auto count = static_cast<std::uint32_t>(facets.size());
+    out.append(reinterpret_cast<const char*>(&count), 4);
+    for (const auto& f : facets) {
+        const float normal[3] = {0, 0, 0};
+        out.append(reinterpret_cast<const char*>(normal), 12);
+        for (const auto& c : f) out.append(reinterpret_cast<const char*>(c.data()), 12);
+        out.append(2, '\0');
+    }
+    return out;
+}
+
+fs::path scratch_folder() {
+    const fs::path p = fs::temp_directory_path() / "gpa_test_stl";
+    fs::create_directories(p);
+    return p;
+}
+
+fs::path write(const std::string& name, const std::string& bytes) {
+    const fs::path p = scratch_folder() / name;
+    std::ofstream(p, std::ios::binary) << bytes;
+    return p;
+}
+
+std::string refusal(const fs::path& file, double unit = 1e-3) {
+    try {
+        (void)read_stl(file, unit);
+    } catch (const InputError& e) {
+        return e.what();
+    }
+    return "";
+}
+
+TEST(Stl, TheBinaryAndAsciiFormsOfACubeReadToTheSameSurfaceInTheUnitGiven) {
+    const auto facets = cube_facets(4.0f);
+    const TriangleSurface ascii = read_stl(write("cube_ascii.stl", ascii_stl(facets)), 1e-3);
+    const TriangleSurface binary = read_stl(write("cube_binary.stl", binary_stl(facets)), 1e-3);
+    EXPECT_EQ(ascii.triangles.size(), 12u);
+    EXPECT_EQ(ascii.vertices.size(), 8u);  // the corners shared, as a closed surface needs
+    EXPECT_EQ(ascii.vertices, binary.vertices);
+    EXPECT_EQ(ascii.triangles, binary.triangles);
+    const auto [lo, hi] = std::minmax_element(ascii.vertices.begin(), ascii.vertices.end());
+    EXPECT_EQ((*lo)[0], 0.0);
+    EXPECT_EQ((*hi)[2], 4e-3);
+    EXPECT_NEAR(enclosed_volume(ascii), 64e-9, 1e-22);
+}
+
+TEST(Stl, CutShortMalformedAndOpenFilesAreRefusedNamingTheFileAndTheLine) {
+    const auto facets = cube_facets(1.0f);
+    std::string binary = binary_stl(facets);
+    const fs::path cut = write("cut.stl", binary.substr(0, binary.size() - 7));
+    EXPECT_NE(refusal(cut).find("cut short or not an STL file"), std::string::npos) << refusal(cut);
+    EXPECT_NE(refusal(cut).find("cut.stl"), std::string::npos);
+
+    std::string text = ascii_stl(facets);
+    const fs::path bad_number = write("bad_number.stl", std::string(text).replace(text.find("vertex 0 0 0") + 9, 1, "x"));
+    EXPECT_NE(refusal(bad_number).find("bad_number.stl:4: \"x\" is not a finite number"), std::string::npos) << refusal(bad_number);
+    const fs::path no_end = write("no_end.stl", text.substr(0, text.find("endsolid")));
+    EXPECT_NE(refusal(no_end).find("no \"endsolid\""), std::string::npos) << refusal(no_end);
+    const fs::path two_corners = write("two.stl", "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nendloop\n");
+    EXPECT_NE(refusal(two_corners).find("two.stl:6: a facet with 2 vertices"), std::string::npos) << refusal(two_corners);
+
+    auto open = facets;
+    open.pop_back();
+    const fs::path hole = write("hole.stl", ascii_stl(open));
+    EXPECT_NE(refusal(hole).find("has a hole"), std::string::npos) << refusal(hole);
+    EXPECT_NE(refusal(scratch_folder() / "missing.stl").find("no such STL file"), std::string::npos);
+    EXPECT_NE(refusal(write("empty.stl", "")).find("not an STL file"), std::string::npos);
+    EXPECT_NE(refusal(write("cube_ascii.stl", ascii_stl(facets)), -1.0).find("must be a positive length"), std::string::npos);
+}
+
+// A 3D scene with a 4 mm box and, 10 mm above it, the same cube as a surface in millimetres.
+std::string surface_scene(const std::string& surface_keys) {
+    return fmt::format(R"(
+name = "surface and box"
+geometry = "3d"
+[[body]]
+name = "box"
+shape = "box"
+material = "OFHC copper"
+origin = [0, 0, 0]
+size = ["4 mm", "4 mm", "4 mm"]
+spacing = "0.5 mm"
+[[body]]
+name = "part"
+material = "OFHC copper"
+origin = [0, 0, "10 mm"]
+spacing = "0.5 mm"
+{}
+[stop]
+max_steps = 1
+)", surface_keys);
+}
+
+std::string scene_refusal(const std::string& text, const fs::path& file) {
+    std::ofstream(file) << text;
+    try {
+        (void)load_scene(file);
+    } catch (const InputError& e) {
+        return e.what();
+    }
+    return "";
+}
+
+TEST(Stl, ASurfaceBesideTheSceneFillsTheNodesOfTheBoxOfItsSize) {
+    const fs::path folder = scratch_folder() / "scene";
+    fs::create_directories(folder / "parts");
+    std::ofstream(folder / "parts" / "cube.stl", std::ios::binary) << binary_stl(cube_facets(4.0f));
+    const fs::path scene_file = folder / "scene.toml";
+    std::ofstream(scene_file) << surface_scene("shape = \"surface\"\nfile = \"parts/cube.stl\"\nunit = \"mm\"");
+    const Scene scene = load_scene(scene_file);
+    ASSERT_TRUE(scene.bodies[1].surface);
+    EXPECT_EQ(scene.bodies[1].surface_unit, 1e-3);
+    Simulation sim(scene, 1);
+    std::array<std::size_t, 2> count{0, 0};
+    for (std::size_t i = 0; i < sim.real_count(); ++i) ++count[static_cast<std::size_t>(sim.nodes().body[i])];
+    EXPECT_EQ(count[0], 512u);
+    EXPECT_EQ(count[1], 512u);
+    // A unit written as a length: the same file read in inches' worth of millimetres.
+    std::ofstream(scene_file) << surface_scene("shape = \"surface\"\nfile = \"parts/cube.stl\"\nunit = \"0.5 mm\"");
+    const Scene half = load_scene(scene_file);
+    EXPECT_EQ(half.bodies[1].surface_unit, 0.5e-3);
+}
+
+TEST(Stl, TheSceneReaderRefusesASurfaceWithoutItsFileOrWithTheKeysOfOtherShapes) {
+    const fs::path folder = scratch_folder() / "refusals";
+    fs::create_directories(folder);
+    std::ofstream(folder / "cube.stl", std::ios::binary) << binary_stl(cube_facets(4.0f));
+    const fs::path file = folder / "scene.toml";
+    const auto expect = [&](const std::string& keys, const std::string& words) {
+        const std::string message = scene_refusal(surface_scene(keys), file);
+        EXPECT_NE(message.find(words), std::string::npos) << keys << "\n -> " << message;
+    };
+    expect("shape = \"surface\"\nfile = \"nowhere.stl\"\nunit = \"mm\"", "body[1] \"part\".file: ");
+    expect("shape = \"surface\"\nfile = \"nowhere.stl\"\nunit = \"mm\"", "nowhere.stl: no such STL file");
+    expect("shape = \"surface\"\nunit = \"mm\"", "file");
+    expect("shape = \"surface\"\nfile = \"cube.stl\"", "unit");
+    expect("shape = \"surface\"\nfile = \"cube.stl\"\nunit = \"furlong\"", "\"furlong\" is not a length unit");
+    expect("shape = \"surface\"\nfile = \"cube.stl\"\nunit = \"mm\"\nradius = \"1 mm\"", "does not apply to a surface");
+    expect("shape = \"box\"\nsize = [\"1 mm\", \"1 mm\", \"1 mm\"]\nfile = \"cube.stl\"", "applies to a surface only");
+    const std::string plane = scene_refusal(R"(
+geometry = "plane-strain"
+[[body]]
+name = "part"
+shape = "surface"
+material = "OFHC copper"
+file = "cube.stl"
+unit = "mm"
+spacing = "0.5 mm"
+[stop]
+max_steps = 1
+)", file);
+    EXPECT_NE(plane.find("is a 3D shape"), std::string::npos) << plane;
+}
+
+}  // namespace
+}  // namespace gpa::io
