@@ -321,6 +321,14 @@ std::string read_file(const fs::path& file) {
     return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
+io::RunSettings settings_for(const fs::path& folder) {
+    io::RunSettings s;
+    s.output = folder;
+    s.threads = 1;
+    return s;
+}
+
+#ifdef GPA_CLI
 // summary.json without its timings (wall and output seconds, speeds), which differ from run to run.
 std::string without_timings(const std::string& text) {
     std::istringstream in(text);
@@ -331,14 +339,6 @@ std::string without_timings(const std::string& text) {
     return out;
 }
 
-io::RunSettings settings_for(const fs::path& folder) {
-    io::RunSettings s;
-    s.output = folder;
-    s.threads = 1;
-    return s;
-}
-
-#ifdef GPA_CLI
 TEST(RunLoopLibrary, WritesTheSameFilesAsTheProgram) {
     const fs::path by_program = scratch("program"), by_library = scratch("library");
     const std::string command = fmt::format("\"{}\" run -q --threads 1 -o \"{}\" \"{}\" > /dev/null", GPA_CLI, by_program.string(),
