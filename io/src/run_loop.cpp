@@ -130,7 +130,29 @@ struct RunState {
     HistoryWriter::Mark history;      // history.csv as it was (not recorded by older checkpoints)
     std::vector<GaugeWriter::Mark> gauges;  // each gauge_<name>.csv as it was, in the scene's gauge order
     std::string program_data;  // RunHooks::checkpoint_data's bytes (any), hex-encoded in the file
+    std::string surfaces;      // surfaces_digest of the scene the run started with (empty: none)
 };
+
+// A digest (FNV-1a, 64 bits, in hex) of the surfaces of the scene's surface bodies, as read from
+// their STL files: the checkpoint's scene fingerprint covers the scene's text only, and a changed
+// STL file would otherwise resume another body. Empty without surface bodies.
+std::string surfaces_digest(const Scene& scene) {
+    std::uint64_t h = 1469598103934665603ull;
+    bool any = false;
+    const auto add = [&](const void* data, std::size_t bytes) {
+        const auto* p = static_cast<const unsigned char*>(data);
+        for (std::size_t k = 0; k < bytes; ++k) h = (h ^ p[k]) * 1099511628211ull;
+    };
+    for (std::size_t b = 0; b < scene.bodies.size(); ++b) {
+        if (!scene.bodies[b].surface) continue;
+        any = true;
+        const TriangleSurface& t = scene.bodies[b].surface->triangles();
+        add(&b, sizeof b);
+        add(t.vertices.data(), t.vertices.size() * sizeof(t.vertices[0]));
+        add(t.triangles.data(), t.triangles.size() * sizeof(t.triangles[0]));
+    }
+    return any ? fmt::format("{:016x}", h) : std::string();
+}
 
 std::string to_hex(const std::string& bytes) {
     static constexpr char digits[] = "0123456789abcdef";
@@ -169,6 +191,7 @@ std::string encode(const RunState& s) {
     out += fmt::format("history={} {:016x}\n", s.history.bytes, s.history.digest);
     for (const auto& g : s.gauges) out += fmt::format("gauge={} {:016x}\n", g.bytes, g.digest);
     if (!s.program_data.empty()) out += fmt::format("program_data={}\n", to_hex(s.program_data));
+    if (!s.surfaces.empty()) out += fmt::format("surfaces={}\n", s.surfaces);
     return out;
 }
 
@@ -187,6 +210,7 @@ RunState decode(const std::string& text, const std::string& source) {
             if (key == "scene_file") s.scene_file = value;
             else if (key == "resolve_from") s.resolve_from = value;
             else if (key == "program_data") s.program_data = from_hex(value);
+            else if (key == "surfaces") s.surfaces = value;
             else if (key == "overwrite") s.overwrite = value == "1";
             else if (key == "wall_seconds") s.wall_seconds = std::stod(value);
             else if (key == "output_seconds") s.output_seconds = std::stod(value);
@@ -607,6 +631,7 @@ RunLoop::RunLoop(SceneSource source, RunSettings settings) : impl_(std::make_uni
     im.folder.emplace(im.settings.output, im.settings.overwrite);
     im.state.scene_file = im.source.label;
     im.state.resolve_from = im.source.file.string();
+    im.state.surfaces = surfaces_digest(scene);
     im.state.overwrite = im.settings.overwrite;
     im.prepare_outputs();
 }
@@ -662,6 +687,12 @@ std::unique_ptr<RunLoop> RunLoop::resume(const fs::path& folder_path, std::optio
             if (surfaces) throw;
             im->warning(e.what());
         }
+    }
+    if (surfaces_digest(scene) != started.surfaces) {
+        throw CheckpointError(fmt::format("the STL files of the surface bodies of '{}' are not those the run in '{}' started with "
+                                          "(their contents changed): the stopped run cannot be continued from them (start it again "
+                                          "with --overwrite)",
+                                          original.string(), partial.string()));
     }
     im->sim.emplace(scene, im->settings.threads, im->settings.memory);
     im->state = decode(read_checkpoint(checkpoint, *im->sim, scene_fingerprint(im->source.text)), checkpoint.string());

@@ -1,5 +1,7 @@
 #include "gpa/io/scene_file.hpp"
 #include "gpa/io/stl.hpp"
+
+#include <new>
 #include "gpa/io/reference.hpp"
 
 #include <array>
@@ -810,6 +812,9 @@ std::string resolve_scene_files(Scene& scene, const std::filesystem::path& scene
             b.surface = std::make_shared<SurfaceInside>(std::make_shared<TriangleSurface>(read_stl(file, b.surface_unit)));
         } catch (const InputError& e) {
             throw InputError(fmt::format("{}: body[{}] \"{}\".file: {}", scene_file.string(), k, b.name, e.what()));
+        } catch (const std::bad_alloc&) {
+            throw InputError(fmt::format("{}: body[{}] \"{}\".file: {}: not enough memory to read it and make its inside test",
+                                         scene_file.string(), k, b.name, file.string()));
         }
     }
     if (scene.element_reference.empty()) return {};

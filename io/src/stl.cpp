@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <map>
@@ -63,53 +64,65 @@ void read_binary(const std::string& bytes, SurfaceBuilder& out, const std::strin
     }
 }
 
+// ASCII STL read as words (any whitespace, CR or LF line ends): "solid [name]" up to its line's
+// end, then per facet "facet normal nx ny nz", "outer loop", three "vertex x y z", "endloop",
+// "endfacet", and "endsolid [name]" (another solid may follow). Messages give the line.
 void read_ascii(const std::string& text, SurfaceBuilder& out, const std::string& what) {
-    std::istringstream in(text);
-    std::string line;
-    std::size_t line_number = 0;
-    std::array<std::array<double, 3>, 3> corners{};
-    int corner = -1;  // -1: outside a loop
-    bool ended = false;
-    const auto fail = [&](const std::string& why) { throw InputError(fmt::format("{}:{}: {}", what, line_number, why)); };
-    while (std::getline(in, line)) {
-        ++line_number;
-        std::istringstream words(line);
-        std::string word;
-        if (!(words >> word)) continue;
-        if (word == "solid" || word == "facet" || word == "endfacet") continue;
-        if (word == "endsolid") {
-            ended = true;
-            continue;
+    std::size_t at = text.rfind("\xEF\xBB\xBF", 0) == 0 ? 3 : 0, line = 1;
+    const auto fail = [&](const std::string& why) { throw InputError(fmt::format("{}:{}: {}", what, line, why)); };
+    const auto space = [](char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\f' || c == '\v'; };
+    // The next word ("" at the end), counting the lines passed.
+    const auto word = [&]() -> std::string_view {
+        while (at < text.size() && space(text[at])) {
+            if (text[at] == '\n' || (text[at] == '\r' && (at + 1 >= text.size() || text[at + 1] != '\n'))) ++line;
+            ++at;
         }
-        if (word == "outer") {
-            if (corner != -1) fail("\"outer loop\" inside a loop");
-            corner = 0;
-        } else if (word == "vertex") {
-            if (corner < 0 || corner > 2) fail(corner < 0 ? "a vertex outside \"outer loop\"" : "a facet with more than three vertices");
-            auto& c = corners[static_cast<std::size_t>(corner)];
-            for (int k = 0; k < 3; ++k) {
-                std::string number;
-                if (!(words >> number)) fail("a vertex needs three coordinates");
-                try {
-                    std::size_t used = 0;
-                    c[static_cast<std::size_t>(k)] = std::stod(number, &used);
-                    if (used != number.size() || !std::isfinite(c[static_cast<std::size_t>(k)])) throw std::invalid_argument(number);
-                } catch (const std::exception&) {
-                    fail(fmt::format("\"{}\" is not a finite number", number));
-                }
+        const std::size_t start = at;
+        while (at < text.size() && !space(text[at])) ++at;
+        return std::string_view(text).substr(start, at - start);
+    };
+    const auto rest_of_line = [&] {
+        while (at < text.size() && text[at] != '\n' && text[at] != '\r') ++at;
+    };
+    const auto expect = [&](std::string_view wanted, std::string_view context) {
+        const std::string_view w = word();
+        if (w != wanted) fail(fmt::format("\"{}\" where {} needs \"{}\"", w.empty() ? "the end of the file" : std::string(w), context, wanted));
+    };
+    const auto number = [&]() {
+        const std::string w(word());
+        char* end = nullptr;
+        const double v = w.empty() ? NAN : std::strtod(w.c_str(), &end);  // (subnormal values are kept)
+        if (w.empty() || end != w.c_str() + w.size() || !std::isfinite(v)) {
+            fail(fmt::format("\"{}\" is not a finite number", w.empty() ? "the end of the file" : w));
+        }
+        return v;
+    };
+    bool in_solid = false;
+    for (std::string_view w = word(); !w.empty(); w = word()) {
+        if (w == "solid" && !in_solid) {
+            rest_of_line();  // its name
+            in_solid = true;
+        } else if (w == "endsolid" && in_solid) {
+            rest_of_line();
+            in_solid = false;
+        } else if (w == "facet" && in_solid) {
+            expect("normal", "a facet");
+            for (int k = 0; k < 3; ++k) (void)number();
+            expect("outer", "a facet");
+            expect("loop", "a facet");
+            std::array<std::array<double, 3>, 3> corners{};
+            for (auto& c : corners) {
+                expect("vertex", "a facet's loop of three vertices");
+                for (double& x : c) x = number();
             }
-            ++corner;
-        } else if (word == "endloop") {
-            if (corner != 3) fail(fmt::format("a facet with {} vertices: each needs three", std::max(corner, 0)));
+            expect("endloop", "a facet's loop of three vertices");
+            expect("endfacet", "a facet");
             out.add(corners);
-            corner = -1;
         } else {
-            fail(fmt::format("\"{}\" is not a word of an ASCII STL file (solid, facet, outer loop, vertex, endloop, endfacet, "
-                             "endsolid)", word));
+            fail(fmt::format("\"{}\" {}", w, in_solid ? "where a facet or \"endsolid\" belongs" : "where \"solid\" belongs"));
         }
     }
-    if (corner != -1) fail("the file ends inside a facet");
-    if (!ended) throw InputError(fmt::format("{}: no \"endsolid\": the file is cut short", what));
+    if (in_solid) throw InputError(fmt::format("{}: no \"endsolid\": the file is cut short", what));
 }
 
 }  // namespace
@@ -130,9 +143,11 @@ TriangleSurface read_stl(const std::filesystem::path& file, double unit) {
     SurfaceBuilder out(unit, what);
     std::uint32_t count = 0;
     if (size >= 84) std::memcpy(&count, bytes.data() + 80, 4);
-    if (size >= 84 && size == 84 + 50 * std::uint64_t(count)) {
+    const bool text = bytes.find('\0') == std::string::npos;  // a binary file has zeros
+    const std::size_t skip = bytes.rfind("\xEF\xBB\xBF", 0) == 0 ? 3 : 0;  // a UTF-8 byte-order mark
+    if (size >= 84 && size == 84 + 50 * std::uint64_t(count) && !(text && bytes.compare(skip, 5, "solid") == 0)) {
         read_binary(bytes, out, what);
-    } else if (bytes.rfind("solid", 0) == 0 && bytes.find('\0') == std::string::npos) {  // text (a binary file has zeros)
+    } else if (text && bytes.compare(skip, 5, "solid") == 0) {
         read_ascii(bytes, out, what);
     } else if (size >= 84) {
         throw InputError(fmt::format("{}: a binary STL file of {} triangles is {} bytes long, this one {} (cut short or not an "

@@ -16,6 +16,8 @@
 
 #include "gpa/engine/errors.hpp"
 #include "gpa/engine/simulation.hpp"
+#include "gpa/engine/state_io.hpp"
+#include "gpa/io/run_loop.hpp"
 #include "gpa/io/scene_file.hpp"
 #include "gpa/io/stl.hpp"
 
@@ -96,6 +98,21 @@ TEST(Stl, TheBinaryAndAsciiFormsOfACubeReadToTheSameSurfaceInTheUnitGiven) {
     EXPECT_NEAR(enclosed_volume(ascii), 64e-9, 1e-22);
 }
 
+// Line ends of any kind, the whole file on one line, a byte-order mark: the same surface.
+TEST(Stl, AsciiFilesAreReadAsWordsWhateverTheirLineEnds) {
+    const std::string text = ascii_stl(cube_facets(2.0f));
+    const TriangleSurface lf = read_stl(write("lf.stl", text), 1.0);
+    std::string cr = text, one_line = text;
+    std::replace(cr.begin(), cr.end(), '\n', '\r');
+    std::replace(one_line.begin(), one_line.end(), '\n', ' ');
+    one_line.replace(one_line.find("solid cube ") , 11, "solid cube\n");  // the name ends its line
+    for (const std::string& form : {cr, one_line, "\xEF\xBB\xBF" + text}) {
+        const TriangleSurface other = read_stl(write("form.stl", form), 1.0);
+        EXPECT_EQ(other.vertices, lf.vertices);
+        EXPECT_EQ(other.triangles, lf.triangles);
+    }
+}
+
 TEST(Stl, CutShortMalformedAndOpenFilesAreRefusedNamingTheFileAndTheLine) {
     const auto facets = cube_facets(1.0f);
     std::string binary = binary_stl(facets);
@@ -109,7 +126,16 @@ TEST(Stl, CutShortMalformedAndOpenFilesAreRefusedNamingTheFileAndTheLine) {
     const fs::path no_end = write("no_end.stl", text.substr(0, text.find("endsolid")));
     EXPECT_NE(refusal(no_end).find("no \"endsolid\""), std::string::npos) << refusal(no_end);
     const fs::path two_corners = write("two.stl", "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nendloop\n");
-    EXPECT_NE(refusal(two_corners).find("two.stl:6: a facet with 2 vertices"), std::string::npos) << refusal(two_corners);
+    EXPECT_NE(refusal(two_corners).find("two.stl:6: \"endloop\" where a facet's loop of three vertices needs \"vertex\""),
+              std::string::npos)
+        << refusal(two_corners);
+    std::string four = text;
+    four.replace(four.find("vertex 0 0 0") , 12, "vertex 0 0 0 7");
+    EXPECT_NE(refusal(write("four.stl", four)).find("four.stl:4: \"7\" where a facet's loop of three vertices needs"), std::string::npos)
+        << refusal(write("four.stl", four));
+    std::string banana = text;
+    banana.replace(banana.find("outer loop"), 10, "outer banana");
+    EXPECT_NE(refusal(write("banana.stl", banana)).find("\"banana\" where a facet needs \"loop\""), std::string::npos);
 
     auto open = facets;
     open.pop_back();
@@ -171,6 +197,34 @@ TEST(Stl, ASurfaceBesideTheSceneFillsTheNodesOfTheBoxOfItsSize) {
     std::ofstream(scene_file) << surface_scene("shape = \"surface\"\nfile = \"parts/cube.stl\"\nunit = \"0.5 mm\"");
     const Scene half = load_scene(scene_file);
     EXPECT_EQ(half.bodies[1].surface_unit, 0.5e-3);
+}
+
+// The checkpoint's fingerprint covers the scene's text; the surfaces read from the STL files are
+// checked on resume too, even where a changed file fills the same number of nodes.
+TEST(Stl, AResumedRunRefusesAnStlFileThatChangedSinceItStarted) {
+    const fs::path folder = scratch_folder() / "resume";
+    fs::remove_all(folder);
+    fs::create_directories(folder);
+    std::ofstream(folder / "cube.stl", std::ios::binary) << binary_stl(cube_facets(4.0f));
+    std::string text = surface_scene("shape = \"surface\"\nfile = \"cube.stl\"\nunit = \"mm\"");
+    text.replace(text.find("max_steps = 1"), 13, "max_steps = 6");
+    std::ofstream(folder / "scene.toml") << text;
+    const fs::path output = folder / "run";
+    {
+        RunSettings settings;
+        settings.output = output;
+        settings.threads = 1;
+        RunLoop run(SceneSource::from_file(folder / "scene.toml"), settings);
+        RunHooks hooks;
+        hooks.stop_requested = [&] { return run.simulation().steps() == 2 ? StopRequest{1, "the test"} : StopRequest{}; };
+        ASSERT_EQ(run.run(hooks).status, RunStatus::Interrupted);
+    }
+    // 3.99 mm: the same 8 x 8 x 8 cell centres inside, another surface.
+    std::ofstream(folder / "cube.stl", std::ios::binary) << binary_stl(cube_facets(3.99f));
+    EXPECT_THROW((void)RunLoop::resume(output, std::nullopt, RunSettings{}), CheckpointError);
+    std::ofstream(folder / "cube.stl", std::ios::binary) << binary_stl(cube_facets(4.0f));
+    EXPECT_EQ(RunLoop::resume(output, std::nullopt, RunSettings{})->run().status, RunStatus::Finished);
+    fs::remove_all(folder);
 }
 
 TEST(Stl, TheSceneReaderRefusesASurfaceWithoutItsFileOrWithTheKeysOfOtherShapes) {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <map>
 #include <utility>
 
@@ -23,18 +24,34 @@ std::array<double, 3> cross(const std::array<double, 3>& a, const std::array<dou
     return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
 }
 
-// Twice the signed area of the xy projection of (a, b, p): > 0 when p is left of a -> b.
-double orient(const std::array<double, 3>& a, const std::array<double, 3>& b, double px, double py) {
-    return (b[0] - a[0]) * (py - a[1]) - (b[1] - a[1]) * (px - a[0]);
+using Snapped = std::array<std::int64_t, 3>;
+__extension__ typedef __int128 Wide;  // exact products of grid coordinates (GCC and Clang)
+
+// Twice the signed area of the xy projection of (a, b, p), exactly: > 0 when p is left of a -> b.
+Wide orient2d(const Snapped& a, const Snapped& b, const Snapped& p) {
+    return static_cast<Wide>(b[0] - a[0]) * (p[1] - a[1]) - static_cast<Wide>(b[1] - a[1]) * (p[0] - a[0]);
+}
+
+// (p - a) . ((b - a) x (c - a)), exactly (coordinates below 2^32: each term below 2^97): > 0 when p
+// lies on the side the normal of (a, b, c) points to by the right-hand rule.
+Wide orient3d(const Snapped& a, const Snapped& b, const Snapped& c, const Snapped& p) {
+    const Wide ux = b[0] - a[0], uy = b[1] - a[1], uz = b[2] - a[2];
+    const Wide vx = c[0] - a[0], vy = c[1] - a[1], vz = c[2] - a[2];
+    const Wide wx = p[0] - a[0], wy = p[1] - a[1], wz = p[2] - a[2];
+    return wx * (uy * vz - uz * vy) + wy * (uz * vx - ux * vz) + wz * (ux * vy - uy * vx);
 }
 
 // The top-left rule for an edge a -> b of a counter-clockwise triangle in the xy projection: a
 // point exactly on it belongs to this triangle when the edge is a top edge (horizontal, the
 // triangle below it: b left of a) or a left edge (going down: b below a).
-bool owns_edge(const std::array<double, 3>& a, const std::array<double, 3>& b) {
-    const double dy = b[1] - a[1];
-    return dy < 0.0 || (dy == 0.0 && b[0] < a[0]);
+bool owns_edge(const Snapped& a, const Snapped& b) {
+    const std::int64_t dy = b[1] - a[1];
+    return dy < 0 || (dy == 0 && b[0] < a[0]);
 }
+
+// Buckets along each axis of the xy grid for `triangles` triangles, and the entries (triangle,
+// bucket) it would hold: a triangle is entered in every bucket its xy box covers.
+constexpr std::size_t max_buckets_per_axis = 2048;
 
 }  // namespace
 
@@ -94,34 +111,66 @@ SurfaceInside::SurfaceInside(std::shared_ptr<const TriangleSurface> surface) : s
             upper_[c] = std::max(upper_[c], v[c]);
         }
     }
-    // About one grid cell per triangle's worth of the xy extent.
-    const double side = std::sqrt(static_cast<double>(std::max<std::size_t>(s.triangles.size(), 1)));
-    for (int c = 0; c < 2; ++c) {
-        const double extent = upper_[c] - lower_[c];
-        cells_[c] = static_cast<std::size_t>(std::clamp(side, 1.0, 2048.0));
-        cell_size_[c] = extent > 0.0 ? extent / static_cast<double>(cells_[c]) : 1.0;
+    double extent = 0.0;
+    for (int c = 0; c < 3; ++c) extent = std::max(extent, upper_[c] - lower_[c]);
+    grid_step_ = extent > 0.0 ? extent / 2147483648.0 : 1.0;  // 2^31 steps across the largest extent
+    snapped_.reserve(s.vertices.size());
+    for (const auto& v : s.vertices) snapped_.push_back(snap(v));
+
+    // The buckets: about one per triangle's worth of the xy extent, fewer where long triangles would
+    // enter too many (at most 32 entries per triangle on average), so that memory stays linear.
+    std::vector<std::array<double, 4>> boxes(s.triangles.size());  // x0, x1, y0, y1 of each triangle
+    for (std::size_t t = 0; t < s.triangles.size(); ++t) {
+        boxes[t] = {INFINITY, -INFINITY, INFINITY, -INFINITY};
+        for (const std::uint32_t v : s.triangles[t]) {
+            boxes[t][0] = std::min(boxes[t][0], s.vertices[v][0]);
+            boxes[t][1] = std::max(boxes[t][1], s.vertices[v][0]);
+            boxes[t][2] = std::min(boxes[t][2], s.vertices[v][1]);
+            boxes[t][3] = std::max(boxes[t][3], s.vertices[v][1]);
+        }
     }
     const auto cell_of = [&](double x, int c) {
         const double k = std::floor((x - lower_[c]) / cell_size_[c]);
         return static_cast<std::size_t>(std::clamp(k, 0.0, static_cast<double>(cells_[c] - 1)));
     };
-    std::vector<std::vector<std::uint32_t>> buckets(cells_[0] * cells_[1]);
-    for (std::size_t t = 0; t < s.triangles.size(); ++t) {
-        std::array<double, 2> lo{INFINITY, INFINITY}, hi{-INFINITY, -INFINITY};
-        for (const std::uint32_t v : s.triangles[t]) {
-            for (int c = 0; c < 2; ++c) {
-                lo[c] = std::min(lo[c], s.vertices[v][c]);
-                hi[c] = std::max(hi[c], s.vertices[v][c]);
-            }
+    const auto set_grid = [&](std::size_t per_axis) {
+        for (int c = 0; c < 2; ++c) {
+            cells_[c] = per_axis;
+            const double e = upper_[c] - lower_[c];
+            cell_size_[c] = e > 0.0 ? e / static_cast<double>(per_axis) : 1.0;
         }
-        for (std::size_t i = cell_of(lo[0], 0); i <= cell_of(hi[0], 0); ++i) {
-            for (std::size_t j = cell_of(lo[1], 1); j <= cell_of(hi[1], 1); ++j) buckets[j * cells_[0] + i].push_back(static_cast<std::uint32_t>(t));
+    };
+    const auto entries = [&] {
+        std::size_t n = 0;
+        for (const auto& box : boxes) n += (cell_of(box[1], 0) - cell_of(box[0], 0) + 1) * (cell_of(box[3], 1) - cell_of(box[2], 1) + 1);
+        return n;
+    };
+    const std::size_t budget = 32 * std::max<std::size_t>(s.triangles.size(), 64);
+    std::size_t per_axis = static_cast<std::size_t>(
+        std::clamp(std::sqrt(static_cast<double>(s.triangles.size())), 1.0, static_cast<double>(max_buckets_per_axis)));
+    set_grid(per_axis);
+    while (per_axis > 1 && entries() > budget) set_grid(per_axis = per_axis / 2);
+    offsets_.assign(cells_[0] * cells_[1] + 1, 0);
+    for (const auto& box : boxes) {
+        for (std::size_t i = cell_of(box[0], 0); i <= cell_of(box[1], 0); ++i) {
+            for (std::size_t j = cell_of(box[2], 1); j <= cell_of(box[3], 1); ++j) ++offsets_[j * cells_[0] + i + 1];
         }
     }
-    offsets_.assign(buckets.size() + 1, 0);
-    for (std::size_t b = 0; b < buckets.size(); ++b) offsets_[b + 1] = offsets_[b] + static_cast<std::uint32_t>(buckets[b].size());
-    members_.reserve(offsets_.back());
-    for (const auto& b : buckets) members_.insert(members_.end(), b.begin(), b.end());
+    for (std::size_t b = 0; b + 1 < offsets_.size(); ++b) offsets_[b + 1] += offsets_[b];
+    members_.resize(offsets_.back());
+    std::vector<std::size_t> next(offsets_.begin(), offsets_.end() - 1);
+    for (std::size_t t = 0; t < boxes.size(); ++t) {
+        const auto& box = boxes[t];
+        for (std::size_t i = cell_of(box[0], 0); i <= cell_of(box[1], 0); ++i) {
+            for (std::size_t j = cell_of(box[2], 1); j <= cell_of(box[3], 1); ++j) members_[next[j * cells_[0] + i]++] = static_cast<std::uint32_t>(t);
+        }
+    }
+}
+
+SurfaceInside::Snapped SurfaceInside::snap(const std::array<double, 3>& p) const {
+    Snapped out{};
+    for (int c = 0; c < 3; ++c) out[c] = std::llround((p[c] - lower_[c]) / grid_step_);
+    return out;
 }
 
 bool SurfaceInside::inside(const std::array<double, 3>& p) const {
@@ -134,27 +183,29 @@ bool SurfaceInside::inside(const std::array<double, 3>& p) const {
         return static_cast<std::size_t>(std::clamp(k, 0.0, static_cast<double>(cells_[c] - 1)));
     };
     const std::size_t b = cell(1) * cells_[0] + cell(0);
+    const Snapped q = snap(p);
     bool in = false;
-    for (std::uint32_t m = offsets_[b]; m < offsets_[b + 1]; ++m) {
+    for (std::size_t m = offsets_[b]; m < offsets_[b + 1]; ++m) {
         const auto& tri = s.triangles[members_[m]];
-        std::array<double, 3> a = s.vertices[tri[0]], q = s.vertices[tri[1]], r = s.vertices[tri[2]];
-        const double area = orient(a, q, r[0], r[1]);
-        if (area == 0.0) continue;   // seen edge-on from above: the ray does not cross it
-        if (area < 0.0) std::swap(q, r);  // counter-clockwise in the projection
-        // The column through p crosses the triangle's projection (edges by the top-left rule).
+        const Snapped* a = &snapped_[tri[0]];
+        const Snapped* u = &snapped_[tri[1]];
+        const Snapped* w = &snapped_[tri[2]];
+        const Wide area = orient2d(*a, *u, *w);
+        if (area == 0) continue;       // seen edge-on from above: the ray does not cross it
+        if (area < 0) std::swap(u, w);  // counter-clockwise in the projection
+        // The column through q crosses the triangle's projection (edges by the top-left rule).
         bool covered = true;
-        for (const auto& [e0, e1] : {std::pair{&a, &q}, std::pair{&q, &r}, std::pair{&r, &a}}) {
-            const double w = orient(*e0, *e1, p[0], p[1]);
-            if (w < 0.0 || (w == 0.0 && !owns_edge(*e0, *e1))) {
+        for (const auto& [e0, e1] : {std::pair{a, u}, std::pair{u, w}, std::pair{w, a}}) {
+            const Wide side = orient2d(*e0, *e1, q);
+            if (side < 0 || (side == 0 && !owns_edge(*e0, *e1))) {
                 covered = false;
                 break;
             }
         }
         if (!covered) continue;
-        // The triangle's height over (p_x, p_y), from its plane; crossed when above p.
-        const auto n = cross(minus(q, a), minus(r, a));
-        const double z = a[2] - (n[0] * (p[0] - a[0]) + n[1] * (p[1] - a[1])) / n[2];
-        if (z > p[2]) in = !in;
+        // (a, u, w) is counter-clockwise seen from above: its normal points up, and the triangle
+        // is above q when q lies below its plane.
+        if (orient3d(*a, *u, *w, q) < 0) in = !in;
     }
     return in;
 }

@@ -609,6 +609,9 @@ void check_prescribed_velocity(const Scene& scene, std::size_t k) {
         fail_here(fmt::format("{}.region lies outside body \"{}\" (it spans {}; radii up to {:.6g} mm from its axis)", label,
                               spec.name, spans, largest_radius(spec, g) * 1e3));
     }
+    // The checks on the body's nodes wait until its shape is known (a surface's file is read after
+    // the scene reader's checks; the Simulation checks the scene again).
+    if (!shape_known(spec)) return;
     const auto axis = body_axis(scene, b);
     const auto inside = [&](const PrescribedVelocitySpec& region, const std::array<double, 3>& p) {
         return in_region(region, g, axis, p);
@@ -732,7 +735,9 @@ std::vector<std::string> scene_warnings(const Scene& scene) {
             smallest = std::min(smallest, e);
             largest = std::max(largest, e);
         };
-        if (b.shape == ShapeKind::Surface) {
+        if (!shape_known(b)) {
+            continue;
+        } else if (b.shape == ShapeKind::Surface) {
             for (int c = 0; c < dim; ++c) {
                 const auto [lo, hi] = gpa::extent(b, scene.geometry, c);
                 extent(hi - lo);

@@ -11,6 +11,13 @@
 // or top side, in the triangles' projection on the xy plane, each made counter-clockwise), so that
 // points on the projection of an edge are neither lost nor counted twice. Triangles seen edge-on
 // (vertical in z) are not crossed.
+//
+// The rule needs the signs of the predicates exact: a point on the projection of an edge must
+// come out on it for both triangles that share the edge, and a sliver whose corners are nearly in
+// a line must not cover points far from it. So the vertices and the query point are snapped to an
+// integer grid of 2^31 steps across the surface's largest extent (a step of 5e-10 of it, far below
+// any lattice spacing), and the side of an edge (orient2d) and of the triangle's plane (orient3d)
+// are computed exactly in 128-bit integers.
 
 #include <array>
 #include <cstdint>
@@ -47,11 +54,16 @@ public:
     const std::array<double, 3>& upper() const { return upper_; }
 
 private:
+    using Snapped = std::array<std::int64_t, 3>;
+    Snapped snap(const std::array<double, 3>& p) const;
+
     std::shared_ptr<const TriangleSurface> surface_;
     std::array<double, 3> lower_{}, upper_{};
-    std::array<std::size_t, 2> cells_{1, 1};
+    double grid_step_ = 1.0;                 // of the integer grid, m
+    std::vector<Snapped> snapped_;           // the vertices on it
+    std::array<std::size_t, 2> cells_{1, 1};  // the bucket grid over xy
     std::array<double, 2> cell_size_{1, 1};
-    std::vector<std::uint32_t> offsets_;  // per grid cell, its triangles in `members_`
+    std::vector<std::size_t> offsets_;       // per bucket, its triangles in `members_`
     std::vector<std::uint32_t> members_;
 };
 
