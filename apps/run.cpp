@@ -13,6 +13,7 @@
 #include "gpa/engine/errors.hpp"
 #include "gpa/engine/simulation.hpp"
 #include "gpa/io/material_library.hpp"
+#include "gpa/io/output.hpp"
 #include "gpa/io/run_loop.hpp"
 #include "gpa/io/scene_file.hpp"
 #include "progress.hpp"
