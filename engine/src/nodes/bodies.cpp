@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <numbers>
 
 #include <fmt/format.h>
 
@@ -82,6 +83,8 @@ LatticeBlock body_lattice(const Scene& scene, std::size_t index) {
                 throw InputError(fmt::format("body \"{}\": a box is a 3D shape; use a rectangle in 2D", b.name));
             case ShapeKind::Surface:
                 throw InputError(fmt::format("body \"{}\": a surface is a 3D shape", b.name));
+            case ShapeKind::Nodes:
+                throw InputError(fmt::format("body \"{}\": its nodes are imported; it has no lattice", b.name));
         }
     } else {
         switch (b.shape) {
@@ -125,6 +128,8 @@ LatticeBlock body_lattice(const Scene& scene, std::size_t index) {
             }
             case ShapeKind::Rectangle:
                 throw InputError(fmt::format("body \"{}\": a rectangle is a 2D shape; use a box in 3D", b.name));
+            case ShapeKind::Nodes:
+                throw InputError(fmt::format("body \"{}\": its nodes are imported; it has no lattice", b.name));
             case ShapeKind::Surface: {
                 // The cells of the spacing as given, from the lower corner of the surface's box (moved
                 // by the origin), across its extent; those whose centre is inside are filled.
@@ -199,12 +204,14 @@ double initial_volumetric_strain(const materials::Material& m, double p, const s
     return 0.5 * (lo + hi);
 }
 
-std::size_t add_body_nodes(NodeStore& nodes, const Scene& scene, std::size_t index, const std::vector<MirrorPlane>& mirrors) {
+namespace {
+
+// Appends body `index`'s lattice (body_lattice, fill_lattice) with its fixed lists.
+std::size_t add_lattice_nodes(NodeStore& nodes, const Scene& scene, std::size_t index, std::size_t material,
+                              const std::vector<MirrorPlane>& mirrors) {
     const BodySpec& b = scene.bodies.at(index);
-    const std::size_t material = material_index(scene, b.material, b.name);
-    const auto& mat = scene.materials[material];
     LatticeBlock block = body_lattice(scene, index);
-    block.density = mat.density;
+    block.density = scene.materials[material].density;
     block.velocity = b.velocity;
     block.body = static_cast<std::int32_t>(index);
     block.material = static_cast<std::int32_t>(material);
@@ -221,6 +228,72 @@ std::size_t add_body_nodes(NodeStore& nodes, const Scene& scene, std::size_t ind
     if (nodes.size() == first) {
         throw InputError(fmt::format("body \"{}\": its lattice holds no node (spacing {} m too coarse for its size)", b.name, b.spacing));
     }
+    return first;
+}
+
+// Appends the imported nodes of body `index` (node_set.hpp) as fill_lattice appends a lattice's,
+// with each node's own volume and diameter, variable connectivity and no fixed lists.
+std::size_t add_imported_nodes(NodeStore& nodes, const Scene& scene, std::size_t index, std::size_t material) {
+    const BodySpec& b = scene.bodies.at(index);
+    if (!b.node_set) {
+        throw InputError(fmt::format("body \"{}\": its nodes (file \"{}\") have not been read: read the scene with "
+                                     "io::load_scene, or call io::resolve_scene_files",
+                                     b.name, b.surface_file));
+    }
+    const NodeSetShape& set = *b.node_set;
+    const int dim = nodes.dim();
+    if (set.dim() != dim) throw InputError(fmt::format("body \"{}\": its node set is {}D, the scene {}D", b.name, set.dim(), dim));
+    const double density = scene.materials[material].density;
+    const std::size_t first = nodes.size();
+    nodes.resize(first + set.size());
+    for (std::size_t k = 0; k < set.size(); ++k) {
+        const std::size_t i = first + k;
+        const auto& x = set.set().positions[k];
+        for (int c = 0; c < dim; ++c) {
+            nodes.position[c][i] = x[c] + b.origin[c];
+            nodes.initial_position[c][i] = nodes.position[c][i];
+            nodes.velocity[c][i] = b.velocity[c];
+        }
+        // As for a lattice cell (fill_lattice): the ring of section A in axisymmetric geometry.
+        const double size = set.set().sizes[k];
+        const double v0 = nodes.geometry() == GeometryKind::Axisymmetric ? 2.0 * std::numbers::pi * nodes.position[0][i] * size : size;
+        nodes.initial_volume[i] = v0;
+        nodes.volume[i] = v0;
+        nodes.mass[i] = density * v0;
+        nodes.initial_diameter[i] = set.diameter(k);
+        nodes.diameter[i] = set.diameter(k);
+        if (dim == 3) {
+            for (int c = 0; c < 6; ++c) nodes.left_cauchy_green[c][i] = c < 3 ? 1.0 : 0.0;
+        }
+        nodes.body[i] = static_cast<std::int32_t>(index);
+        nodes.id[i] = static_cast<std::uint32_t>(i);  // the fill order (node_store.hpp)
+        nodes.material[i] = static_cast<std::int32_t>(material);
+        nodes.connectivity[i] = Connectivity::Variable;
+    }
+    // No fixed lists: an empty row per node.
+    auto& rows = nodes.fixed_neighbours;
+    rows.offsets.resize(first + 1);
+    rows.indices.resize(rows.offsets.back());
+    auto& mirrors = nodes.fixed_mirrors;
+    mirrors.offsets.resize(first + 1);
+    mirrors.indices.resize(mirrors.offsets.back());
+    nodes.fixed_mirror_planes.resize(mirrors.offsets.back());
+    for (std::size_t k = 0; k < set.size(); ++k) {
+        rows.offsets.push_back(rows.indices.size());
+        mirrors.offsets.push_back(mirrors.indices.size());
+    }
+    return first;
+}
+
+}  // namespace
+
+std::size_t add_body_nodes(NodeStore& nodes, const Scene& scene, std::size_t index, const std::vector<MirrorPlane>& mirrors) {
+    const BodySpec& b = scene.bodies.at(index);
+    const std::size_t material = material_index(scene, b.material, b.name);
+    const auto& mat = scene.materials[material];
+    const int dim = nodes.dim();
+    const std::size_t first = b.shape == ShapeKind::Nodes ? add_imported_nodes(nodes, scene, index, material)
+                                                          : add_lattice_nodes(nodes, scene, index, material, mirrors);
     // Initial stress: deviator into s, mean stress into an initial compression.
     const auto& sig = b.initial_stress;
     const double mean = dim == 2 ? (sig[0] + sig[1] + sig[3]) / 3.0 : (sig[0] + sig[1] + sig[2]) / 3.0;

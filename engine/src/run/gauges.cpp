@@ -178,7 +178,12 @@ Gauge::Gauge(const GaugeSpec& spec, const Scene& scene, const NodeStore& nodes, 
     // Each particle body's lattice spacing per axis: a node's cell extends half of it either way.
     std::vector<std::array<double, 3>> spacing(scene.bodies.size(), std::array<double, 3>{0.0, 0.0, 0.0});
     for (std::size_t b = 0; b < scene.bodies.size(); ++b) {
-        if (scene.bodies[b].discretisation == Discretisation::Particles) spacing[b] = body_lattice(scene, b).spacing;
+        const BodySpec& spec = scene.bodies[b];
+        if (spec.shape == ShapeKind::Nodes) {  // imported nodes: their median diameter
+            spacing[b] = {nominal_spacing(spec), nominal_spacing(spec), nominal_spacing(spec)};
+        } else if (spec.discretisation == Discretisation::Particles) {
+            spacing[b] = body_lattice(scene, b).spacing;
+        }
     }
     const auto cell = [&](std::size_t i, int axis) { return spacing[static_cast<std::size_t>(nodes.body[i])][static_cast<std::size_t>(axis)]; };
     const auto largest_cell = [&](std::size_t i) {

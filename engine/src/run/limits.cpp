@@ -43,6 +43,10 @@ double list_entries_per_node(int dim) { return dim == 3 ? 56.0 : 21.0; }
 double estimated_node_count(const Scene& scene) {
     double nodes = 0.0;
     for (std::size_t b = 0; b < scene.bodies.size(); ++b) {
+        if (scene.bodies[b].shape == ShapeKind::Nodes) {
+            if (scene.bodies[b].node_set) nodes += double(scene.bodies[b].node_set->size());
+            continue;
+        }
         const LatticeBlock block = body_lattice(scene, b);
         double cells = 1.0;
         for (int k = 0; k < 3; ++k) cells *= std::max(0.0, double(block.last[k]) - double(block.first[k]));

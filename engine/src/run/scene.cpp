@@ -54,6 +54,16 @@ char axis_letter(int axis, int dim) {
     return axis == 0 ? 'x' : axis == 1 ? 'y' : 'z';
 }
 
+// How far a body may reach past a plane at `position` and still be on its side (touching it). For
+// imported nodes a quarter of their median diameter: their extent is that of cubes (squares) of
+// side d0 about them, which need not be the cells they stand for (a cell of dx by dz, dx != dz, is
+// not the square of side sqrt(dx dz)); their nodes then still lie a quarter diameter or more on the
+// plane's side.
+double plane_tolerance(const BodySpec& b, double position) {
+    if (b.shape == ShapeKind::Nodes) return 0.25 * nominal_spacing(b);
+    return 1e-9 * std::max(b.spacing, std::abs(position));
+}
+
 bool known_shape(ShapeKind s) {
     switch (s) {
         case ShapeKind::Cylinder:
@@ -61,14 +71,19 @@ bool known_shape(ShapeKind s) {
         case ShapeKind::Rectangle:
         case ShapeKind::Box:
         case ShapeKind::Sphere:
-        case ShapeKind::Surface: return true;
+        case ShapeKind::Surface:
+        case ShapeKind::Nodes: return true;
     }
     return false;
 }
 
 // Whether a body's shape is known: a surface before its file is read is not (a scene reader checks
 // the scene before it reads the files; the checks of its extent wait for the Simulation's).
-bool shape_known(const BodySpec& b) { return b.shape != ShapeKind::Surface || b.surface != nullptr; }
+bool shape_known(const BodySpec& b) {
+    if (b.shape == ShapeKind::Surface) return b.surface != nullptr;
+    if (b.shape == ShapeKind::Nodes) return b.node_set != nullptr;
+    return true;
+}
 
 // The interval a body occupies along an axis (before any node is placed).
 std::pair<double, double> extent(const BodySpec& b, GeometryKind g, int axis) {
@@ -89,6 +104,10 @@ std::pair<double, double> extent(const BodySpec& b, GeometryKind g, int axis) {
         case ShapeKind::Surface: {
             if (!b.surface) return {o, o};
             return {o + b.surface->lower()[static_cast<std::size_t>(axis)], o + b.surface->upper()[static_cast<std::size_t>(axis)]};
+        }
+        case ShapeKind::Nodes: {
+            if (!b.node_set) return {o, o};
+            return {o + b.node_set->lower()[static_cast<std::size_t>(axis)], o + b.node_set->upper()[static_cast<std::size_t>(axis)]};
         }
     }
     return {o, o};
@@ -127,6 +146,8 @@ bool inside_shape(const BodySpec& b, GeometryKind g, const std::array<double, 3>
             return true;
         case ShapeKind::Surface:
             return b.surface && b.surface->inside({p[0] - o[0], p[1] - o[1], p[2] - o[2]});
+        case ShapeKind::Nodes:
+            return b.node_set && b.node_set->covers({p[0] - o[0], p[1] - o[1], dim == 3 ? p[2] - o[2] : 0.0});
     }
     return false;
 }
@@ -150,6 +171,30 @@ void check_overlap(const Scene& scene, std::size_t a, std::size_t b) {
         hi[static_cast<std::size_t>(k)] = std::min(hi_a, hi_b);
         if (!(lo[static_cast<std::size_t>(k)] < hi[static_cast<std::size_t>(k)])) return;  // apart or touching
     }
+    std::size_t overlapping = 0;
+    std::array<double, 3> example{};
+    const auto report = [&](std::int64_t stride) {
+        if (overlapping == 0) return;
+        const std::string where = dim == 2 ? fmt::format("(x, z) = ({:.6g}, {:.6g}) mm", 1e3 * example[0], 1e3 * example[1])
+                                           : fmt::format("(x, y, z) = ({:.6g}, {:.6g}, {:.6g}) mm", 1e3 * example[0],
+                                                         1e3 * example[1], 1e3 * example[2]);
+        fail(fmt::format("{} overlaps {}: {}{} of its nodes lie inside it, the first at {}; bodies may touch but not overlap "
+                         "(move one, or make it smaller)",
+                         body_label(first, a), body_label(second, b), stride > 1 ? "at least " : "", overlapping, where));
+    };
+    if (first.shape == ShapeKind::Nodes) {
+        // Its own nodes, all of them.
+        const auto& o = first.origin;
+        const NodeSetShape& set = *first.node_set;
+        for (std::size_t k = 0; k < set.size(); ++k) {
+            const auto& x = set.set().positions[k];
+            const std::array<double, 3> p{x[0] + o[0], x[1] + o[1], dim == 3 ? x[2] + o[2] : 0.0};
+            if (!inside_shape(second, g, p)) continue;
+            if (overlapping++ == 0) example = p;
+        }
+        report(1);
+        return;
+    }
     const LatticeBlock block = body_lattice(scene, a);
     // The cells of the first body's block whose centres fall in the overlap of the extents.
     std::array<std::int64_t, 3> first_cell{0, 0, 0}, last_cell{1, 1, 1};
@@ -163,8 +208,6 @@ void check_overlap(const Scene& scene, std::size_t a, std::size_t b) {
         cells *= static_cast<double>(last_cell[c] - first_cell[c]);
     }
     const auto stride = static_cast<std::int64_t>(std::max(1.0, std::ceil(std::pow(cells / 4e6, 1.0 / dim))));
-    std::size_t overlapping = 0;
-    std::array<double, 3> example{};
     for (std::int64_t k2 = first_cell[2]; k2 < last_cell[2]; k2 += dim == 3 ? stride : 1) {
         for (std::int64_t k1 = first_cell[1]; k1 < last_cell[1]; k1 += stride) {
             for (std::int64_t k0 = first_cell[0]; k0 < last_cell[0]; k0 += stride) {
@@ -179,13 +222,7 @@ void check_overlap(const Scene& scene, std::size_t a, std::size_t b) {
             }
         }
     }
-    if (overlapping == 0) return;
-    const std::string where = dim == 2 ? fmt::format("(x, z) = ({:.6g}, {:.6g}) mm", 1e3 * example[0], 1e3 * example[1])
-                                       : fmt::format("(x, y, z) = ({:.6g}, {:.6g}, {:.6g}) mm", 1e3 * example[0],
-                                                     1e3 * example[1], 1e3 * example[2]);
-    fail(fmt::format("{} overlaps {}: {}{} of its nodes lie inside it, the first at {}; bodies may touch but not overlap "
-                     "(move one, or make it smaller)",
-                     body_label(first, a), body_label(second, b), stride > 1 ? "at least " : "", overlapping, where));
+    report(stride);
 }
 
 // The lattice spacing along an axis.
@@ -244,6 +281,32 @@ void check_body(const Scene& scene, const BodySpec& b, std::size_t i) {
         // (A scene reader checks the scene before it reads the surface files: body_lattice refuses a
         // body whose surface is still missing when its nodes are made.)
         if (b.surface) check_surface(b.surface->triangles(), fmt::format("{}.file \"{}\"", label, b.surface_file));
+    } else if (b.shape == ShapeKind::Nodes) {
+        // Imported nodes (node_set.hpp): their own sizes, no lattice.
+        if (b.node_set) {
+            if (b.node_set->dim() != dim) {
+                fail(fmt::format("{}: its node set is {}D, the scene {}D", label, b.node_set->dim(), dim));
+            }
+            check_node_set(b.node_set->set(), dim, g == GeometryKind::Axisymmetric,
+                           fmt::format("{}.file \"{}\"", label, b.surface_file));
+            if (g == GeometryKind::Axisymmetric && b.origin[0] != 0.0) {
+                fail(fmt::format("{}.origin: in an axisymmetric scene imported nodes keep their radii, so origin x must be 0 "
+                                 "(is {} m)", label, b.origin[0]));
+            }
+        }
+        if (b.discretisation != Discretisation::Particles) {
+            fail(fmt::format("{}.discretisation: imported nodes are particles (elements need a mesh of the shape)", label));
+        }
+        if (b.connectivity && *b.connectivity != ConnectivityMode::Variable) {
+            fail(fmt::format("{}.connectivity: imported nodes have no lattice, so they take variable connectivity only", label));
+        }
+        if (b.lattice_neighbours != 0) {
+            fail(fmt::format("{}.lattice_neighbours: imported nodes have no lattice (their connectivity is variable)", label));
+        }
+        if (b.spacing != 0.0 || b.spacing_z != 0.0) {
+            fail(fmt::format("{}.spacing: imported nodes bring their own sizes (their volumes or areas); give no spacing", label));
+        }
+        return;
     } else if (is_round(b.shape)) {
         if (!(b.radius > 0.0 && finite(b.radius))) {
             fail(fmt::format("{}.radius = {} must be a positive length (m)", label, b.radius));
@@ -408,8 +471,14 @@ void check_plane(const Scene& scene, const PlaneSpec& p, std::size_t i) {
         const BodySpec& b = scene.bodies[k];
         if (!shape_known(b)) continue;
         const auto [lo, hi] = extent(b, g, p.axis);
-        const double tolerance = 1e-9 * std::max(b.spacing, std::abs(p.position));
+        const double tolerance = plane_tolerance(b, p.position);
         if (symmetry_plane_cuts(scene, k, i)) {
+            if (b.shape == ShapeKind::Nodes) {
+                fail(fmt::format("{} at {} = {} m cuts {}, whose nodes are imported: a symmetry plane may cut a body filled "
+                                 "with a lattice (it keeps the cells on its side), but imported nodes must all lie on its "
+                                 "side, half a node's diameter or more from it",
+                                 label, letter, p.position, body_label(b, k)));
+            }
             // A half or quarter model: the body is filled on the plane's side (body_lattice), and the
             // plane's ghosts continue it across.
             if (b.discretisation == Discretisation::Elements) {
@@ -496,8 +565,20 @@ std::string region_label(const PrescribedVelocitySpec& r, std::size_t i) {
 template <class F>
 bool any_initial_node(const Scene& scene, std::size_t b, const std::array<double, 3>& lo, const std::array<double, 3>& hi,
                       F&& visit) {
-    const LatticeBlock block = body_lattice(scene, b);
     const int dim = dimension_of(scene.geometry);
+    if (const BodySpec& spec = scene.bodies[b]; spec.shape == ShapeKind::Nodes) {  // its imported nodes
+        const auto& o = spec.origin;
+        std::array<double, 3> from = lo, to = hi;
+        for (int c = 0; c < dim; ++c) {
+            from[c] -= o[c];
+            to[c] -= o[c];
+        }
+        return spec.node_set->any_in_box(from, to, [&](std::size_t k) {
+            const auto& x = spec.node_set->set().positions[k];
+            return visit(std::array<double, 3>{x[0] + o[0], x[1] + o[1], dim == 3 ? x[2] + o[2] : 0.0});
+        });
+    }
+    const LatticeBlock block = body_lattice(scene, b);
     const bool elements = scene.bodies[b].discretisation == Discretisation::Elements;
     std::array<std::int64_t, 3> from = block.first, to = block.last;
     for (int c = 0; c < dim; ++c) {
@@ -533,8 +614,12 @@ bool any_initial_node(const Scene& scene, std::size_t b, const std::array<double
 // The largest distance of a body's points from its axis (prescribed.hpp, body_axis).
 double largest_radius(const BodySpec& b, GeometryKind g) {
     if (is_round(b.shape)) return b.radius;
-    if (b.shape == ShapeKind::Surface) {
-        // (3D only) half the diagonal of its box across z, from the box's centre line.
+    if (b.shape == ShapeKind::Nodes && dimension_of(g) == 2) {
+        const auto [x0, x1] = extent(b, g, 0);
+        return g == GeometryKind::Axisymmetric ? x1 : 0.5 * (x1 - x0);
+    }
+    if (b.shape == ShapeKind::Surface || b.shape == ShapeKind::Nodes) {
+        // (3D) half the diagonal of its box across z, from the box's centre line.
         const auto [x0, x1] = extent(b, g, 0);
         const auto [y0, y1] = extent(b, g, 1);
         return 0.5 * std::hypot(x1 - x0, y1 - y0);
@@ -602,7 +687,7 @@ void check_prescribed_velocity(const Scene& scene, std::size_t k) {
     for (int c = 0; c < dim && shape_known(spec); ++c) {
         const auto [lo, hi] = extent(spec, g, c);
         spans += fmt::format("{}{} from {:.6g} to {:.6g} mm", c ? ", " : "", axis_letter(c, dim), lo * 1e3, hi * 1e3);
-        const double tolerance = 1e-9 * std::max(spec.spacing, std::max(std::abs(lo), std::abs(hi)));
+        const double tolerance = 1e-9 * std::max(nominal_spacing(spec), std::max(std::abs(lo), std::abs(hi)));
         outside = outside || r.upper[c] < lo - tolerance || r.lower[c] > hi + tolerance;
     }
     if (outside) {
@@ -617,6 +702,11 @@ void check_prescribed_velocity(const Scene& scene, std::size_t k) {
         return in_region(region, g, axis, p);
     };
     if (!any_initial_node(scene, b, r.lower, r.upper, [&](const auto& p) { return inside(r, p); })) {
+        if (spec.shape == ShapeKind::Nodes) {
+            fail_here(fmt::format("{}.region holds no node of body \"{}\" (imported nodes, typically {:.4g} mm apart): "
+                                  "widen it",
+                                  label, spec.name, nominal_spacing(spec) * 1e3));
+        }
         const LatticeBlock block = body_lattice(scene, b);
         fail_here(fmt::format("{}.region holds no node of body \"{}\": it lies between the rows of its lattice (spacing {:.4g} "
                               "mm); make it at least one spacing wide",
@@ -638,8 +728,10 @@ void check_prescribed_velocity(const Scene& scene, std::size_t k) {
     }
     // A plane (or the axis) that the region's nodes touch and that the region would move them
     // along the normal of: through a rigid wall, off a symmetry plane.
-    const LatticeBlock block = body_lattice(scene, b);
-    const double d0 = dim == 3 ? block.spacing[0] : std::sqrt(block.spacing[0] * block.spacing[1]);
+    const double d0 = spec.shape == ShapeKind::Nodes ? nominal_spacing(spec) : [&] {
+        const LatticeBlock block = body_lattice(scene, b);
+        return dim == 3 ? block.spacing[0] : std::sqrt(block.spacing[0] * block.spacing[1]);
+    }();
     const auto moves_along = [&](int a) { return r.velocity[a] && *r.velocity[a] != 0.0; };
     const auto touches = [&](int a, double position) {
         return any_initial_node(scene, b, r.lower, r.upper,
@@ -670,6 +762,7 @@ std::string_view name_of(ShapeKind s) {
         case ShapeKind::Box: return "box";
         case ShapeKind::Sphere: return "sphere";
         case ShapeKind::Surface: return "surface";
+        case ShapeKind::Nodes: return "nodes";
     }
     return "?";
 }
@@ -737,7 +830,7 @@ std::vector<std::string> scene_warnings(const Scene& scene) {
         };
         if (!shape_known(b)) {
             continue;
-        } else if (b.shape == ShapeKind::Surface) {
+        } else if (b.shape == ShapeKind::Surface || b.shape == ShapeKind::Nodes) {
             for (int c = 0; c < dim; ++c) {
                 const auto [lo, hi] = gpa::extent(b, scene.geometry, c);
                 extent(hi - lo);
@@ -762,6 +855,11 @@ std::vector<std::string> scene_warnings(const Scene& scene) {
                                   "time sound takes across a node: check its unit (s, ms, us)", scene.stop.end_time));
     }
     return out;
+}
+
+double nominal_spacing(const BodySpec& b) {
+    if (b.shape == ShapeKind::Nodes) return b.node_set ? b.node_set->typical_diameter() : 0.0;
+    return b.spacing;
 }
 
 double cylinder_radius_at(const BodySpec& b, double height) {
@@ -800,7 +898,7 @@ std::optional<SymmetrySpan> symmetry_span(const Scene& scene, std::size_t body, 
     const BodySpec& b = scene.bodies[body];
     if (!shape_known(b)) return std::nullopt;
     const auto [lo, hi] = extent(b, scene.geometry, p.axis);
-    return SymmetrySpan{lo, hi, p.position, 1e-9 * std::max(b.spacing, std::abs(p.position))};
+    return SymmetrySpan{lo, hi, p.position, plane_tolerance(b, p.position)};
 }
 
 }  // namespace

@@ -237,7 +237,7 @@ void Measures::local_fields(const Scene& scene, const NodeStore& nodes, std::siz
     // triangles; the face roughness over the points on the body's base.
     out.radius = scene.output.peak_radius > 0.0 ? scene.output.peak_radius
                  : scene.bodies.empty()        ? 0.0
-                                               : 2.0 * scene.bodies.front().spacing;
+                                               : 2.0 * nominal_spacing(scene.bodies.front());
     out.measured = out.radius > 0.0;
     if (!out.measured) return;
     const int d = nodes.dim();

@@ -13,6 +13,10 @@ std::array<double, 2> body_axis(const Scene& scene, std::size_t body) {
         return {b.origin[0] + 0.5 * (b.surface->lower()[0] + b.surface->upper()[0]),
                 b.origin[1] + 0.5 * (b.surface->lower()[1] + b.surface->upper()[1])};
     }
+    if (b.shape == ShapeKind::Nodes && b.node_set) {  // the centre line of its nodes' box
+        return {b.origin[0] + 0.5 * (b.node_set->lower()[0] + b.node_set->upper()[0]),
+                scene.geometry == GeometryKind::ThreeD ? b.origin[1] + 0.5 * (b.node_set->lower()[1] + b.node_set->upper()[1]) : 0.0};
+    }
     return {b.origin[0] + 0.5 * b.size[0], scene.geometry == GeometryKind::ThreeD ? b.origin[1] + 0.5 * b.size[1] : 0.0};
 }
 

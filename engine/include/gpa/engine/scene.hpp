@@ -19,6 +19,7 @@
 #include "gpa/engine/errors.hpp"
 #include "gpa/engine/gauges.hpp"
 #include "gpa/engine/geometry.hpp"
+#include "gpa/engine/node_set.hpp"
 #include "gpa/engine/snapshot_fields.hpp"
 #include "gpa/engine/surface.hpp"
 #include "gpa/engine/weights.hpp"
@@ -53,6 +54,7 @@ enum class ShapeKind {
     Box,        // 3D: a box from origin to origin + size
     Sphere,     // centre `origin`, `radius` (a disc in plane strain; a sphere on the axis in axisymmetric)
     Surface,    // 3D: the inside of a closed triangulated surface (BodySpec::surface), moved by `origin`
+    Nodes,      // nodes imported with their positions and sizes (BodySpec::node_set), moved by `origin`
 };
 
 // The scene-file word of a shape ("cylinder", ...), and whether it is round (has a radius).
@@ -113,6 +115,11 @@ struct BodySpec {
     std::string surface_file;
     double surface_unit = 1.0;
     std::shared_ptr<const SurfaceInside> surface;
+    // Nodes only: the nodes, in metres before the origin is added (null until read). The file and
+    // its unit are surface_file and surface_unit, as for a surface. Such a body has no lattice:
+    // `spacing` is not used (nominal_spacing gives the nodes' median diameter), its nodes have
+    // variable connectivity, and it is discretised with particles.
+    std::shared_ptr<const NodeSetShape> node_set;
     double spacing = 0.0;                 // lattice spacing dx (and dy, dz in 3D)
     double spacing_z = 0.0;               // 2D: dz; 0 = equal to dx
     std::string material;                 // a name in Scene::materials
@@ -129,6 +136,10 @@ struct BodySpec {
 // [0, length]. A lattice node belongs to the body when its cell centre lies within it
 // (docs/scene-format.md).
 double cylinder_radius_at(const BodySpec& b, double height);
+
+// A body's node size as given: its lattice spacing dx (`spacing`), or for imported nodes their
+// median diameter (0 before they are read).
+double nominal_spacing(const BodySpec& b);
 
 enum class PlaneKind {
     Rigid,     // a rigid wall; pushes only unless lift_off is false; frictionless unless given friction
