@@ -147,7 +147,7 @@ fs::path default_output_folder(const std::string& root, const std::string& scene
 
 int check_scene(const fs::path& file, const MemoryLimit& memory) {
     std::string warning;
-    const Scene scene = io::load_scene(file, &warning);
+    const Scene scene = io::load_scene(file, &warning, memory);
     // Implausible values first: a unit slip in a size may make the set-up below refuse the scene
     // for its memory, and the user should see why.
     log_scene_warnings(scene, file.string());
@@ -159,6 +159,18 @@ int check_scene(const fs::path& file, const MemoryLimit& memory) {
     fmt::print("  {} ({}), {} bod{}, {} real nodes, {} ghost nodes at the start\n", scene.name, name_of(scene.geometry),
                scene.bodies.size(), scene.bodies.size() == 1 ? "y" : "ies", sim.real_count(), sim.totals().ghost_nodes);
     for (std::size_t b = 0; b < scene.bodies.size(); ++b) {
+        if (const BodySpec& spec = scene.bodies[b]; spec.shape == ShapeKind::Nodes) {
+            const NodeSetShape& set = *spec.node_set;
+            double smallest = set.diameter(0), largest = smallest;
+            for (std::size_t k = 0; k < set.size(); ++k) {
+                smallest = std::min(smallest, set.diameter(k));
+                largest = std::max(largest, set.diameter(k));
+            }
+            fmt::print("  body \"{}\": {}, {} imported nodes (from {}), diameters {:.4g} to {:.4g} mm, median {:.4g} mm\n",
+                       spec.name, spec.material, set.size(), spec.surface_file, smallest * 1e3, largest * 1e3,
+                       set.typical_diameter() * 1e3);
+            continue;
+        }
         const auto block = body_lattice(scene, b);
         std::size_t count = 0;
         for (std::size_t i = 0; i < sim.real_count(); ++i) count += sim.nodes().body[i] == static_cast<int>(b);

@@ -182,9 +182,10 @@ int run_study(const StudyOptions& options) {
         for (int& t : threads) t = t == 0 ? hardware_threads() : t;
         std::vector<double> cells;
         for (double f : factors) {
-            Scene s = io::refined(base, f);
+            Scene s;
             double cell = 0.0;
             try {
+                s = io::refined(base, f);
                 validate_scene(s);
                 cell = io::lattice_cell_size(s);
             } catch (const InputError& e) {

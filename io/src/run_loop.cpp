@@ -133,9 +133,10 @@ struct RunState {
     std::string surfaces;      // surfaces_digest of the scene the run started with (empty: none)
 };
 
-// A digest (FNV-1a, 64 bits, in hex) of the surfaces of the scene's surface bodies, as read from
-// their STL files: the checkpoint's scene fingerprint covers the scene's text only, and a changed
-// STL file would otherwise resume another body. Empty without surface bodies.
+// A digest (FNV-1a, 64 bits, in hex) of the surfaces of the scene's surface bodies and the nodes of
+// its imported bodies, as read from their STL and node files: the checkpoint's scene fingerprint
+// covers the scene's text only, and a changed file would otherwise resume another body. Empty
+// without such bodies. (Kept under the run state's key "surfaces", which predates node files.)
 std::string surfaces_digest(const Scene& scene) {
     std::uint64_t h = 1469598103934665603ull;
     bool any = false;
@@ -150,6 +151,14 @@ std::string surfaces_digest(const Scene& scene) {
         add(&b, sizeof b);
         add(t.vertices.data(), t.vertices.size() * sizeof(t.vertices[0]));
         add(t.triangles.data(), t.triangles.size() * sizeof(t.triangles[0]));
+    }
+    for (std::size_t b = 0; b < scene.bodies.size(); ++b) {
+        if (!scene.bodies[b].node_set) continue;
+        any = true;
+        const NodeSet& n = scene.bodies[b].node_set->set();
+        add(&b, sizeof b);
+        add(n.positions.data(), n.positions.size() * sizeof(n.positions[0]));
+        add(n.sizes.data(), n.sizes.size() * sizeof(n.sizes[0]));
     }
     return any ? fmt::format("{:016x}", h) : std::string();
 }
@@ -362,7 +371,7 @@ struct RunLoop::Impl {
     // Resolves the files a scene names relative to `file` and says when one is not there
     // (resolve_scene_files).
     void resolve_files(Scene& scene, const fs::path& file) {
-        if (const std::string w = resolve_scene_files(scene, file); !w.empty()) warning(w);
+        if (const std::string w = resolve_scene_files(scene, file, settings.memory); !w.empty()) warning(w);
     }
 
     void prepare_outputs() {
@@ -670,13 +679,15 @@ std::unique_ptr<RunLoop> RunLoop::resume(const fs::path& folder_path, std::optio
     const RunState started = decode(info.user_data, checkpoint.string());
     const fs::path original = given ? im->source.file
                                     : fs::path(started.resolve_from.empty() ? started.scene_file : started.resolve_from);
-    // Bodies of shape "surface" cannot run without their STL files, found from there too.
-    const bool surfaces = std::any_of(scene.bodies.begin(), scene.bodies.end(),
-                                      [](const BodySpec& b) { return b.shape == ShapeKind::Surface; });
+    // Bodies of shape "surface" or "nodes" cannot run without their STL or node files, found from
+    // there too.
+    const bool surfaces = std::any_of(scene.bodies.begin(), scene.bodies.end(), [](const BodySpec& b) {
+        return b.shape == ShapeKind::Surface || b.shape == ShapeKind::Nodes;
+    });
     std::error_code ec;
     const bool original_there = !original.empty() && fs::exists(original, ec);
     if (surfaces && !original_there) {
-        throw InputError(fmt::format("{}: its bodies' STL files are found beside the scene file the run started from, '{}', which "
+        throw InputError(fmt::format("{}: its bodies' STL or node files are found beside the scene file the run started from, '{}', which "
                                      "is not there: give that scene file with the folder to resume",
                                      partial.string(), original.string()));
     }
@@ -689,7 +700,7 @@ std::unique_ptr<RunLoop> RunLoop::resume(const fs::path& folder_path, std::optio
         }
     }
     if (surfaces_digest(scene) != started.surfaces) {
-        throw CheckpointError(fmt::format("the STL files of the surface bodies of '{}' are not those the run in '{}' started with "
+        throw CheckpointError(fmt::format("the STL or node files of the imported bodies of '{}' are not those the run in '{}' started with "
                                           "(their contents changed): the stopped run cannot be continued from them (start it again "
                                           "with --overwrite)",
                                           original.string(), partial.string()));

@@ -1,9 +1,11 @@
 #include "gpa/io/scene_file.hpp"
+#include "gpa/io/node_file.hpp"
 #include "gpa/io/stl.hpp"
 
 #include <new>
 #include "gpa/io/reference.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <cmath>
@@ -197,8 +199,9 @@ BodySpec read_body(const Reporter& reporter, const toml::table& table, std::size
                                                      {"rectangle", ShapeKind::Rectangle},
                                                      {"box", ShapeKind::Box},
                                                      {"sphere", ShapeKind::Sphere},
-                                                     {"surface", ShapeKind::Surface}});
-    if (!shape) r.fail_missing("shape", "cylinder, plate, rectangle, box, sphere or surface");
+                                                     {"surface", ShapeKind::Surface},
+                                                     {"nodes", ShapeKind::Nodes}});
+    if (!shape) r.fail_missing("shape", "cylinder, plate, rectangle, box, sphere, surface or nodes");
     b.shape = *shape;
     if (b.shape == ShapeKind::Surface && dim == 2) {
         r.fail_at("shape", fmt::format("\"surface\" (a closed triangulated surface from an STL file) is a 3D shape; {} takes "
@@ -226,14 +229,27 @@ BodySpec read_body(const Reporter& reporter, const toml::table& table, std::size
     }
 
     const std::string_view shape_name = name_of(b.shape);
-    if (b.shape == ShapeKind::Surface) {
+    const bool imported = b.shape == ShapeKind::Surface || b.shape == ShapeKind::Nodes;
+    if (imported) {
+        const bool surface = b.shape == ShapeKind::Surface;
+        const std::string what = surface ? "the STL file of the closed surface" : "the CSV or VTK file of the nodes";
         for (const std::string_view key : {"radius", "diameter", "length", "size", "inner_radius", "nose"}) {
-            if (r.has(key)) r.fail_at(key, "does not apply to a surface (its STL file gives its shape)");
+            if (r.has(key)) {
+                r.fail_at(key, surface ? "does not apply to a surface (its STL file gives its shape)"
+                                       : "does not apply to imported nodes (their file gives their positions and sizes)");
+            }
         }
-        b.surface_file = r.required_string("file", "the STL file of the closed surface, relative to the scene file");
-        if (b.surface_file.empty()) r.fail_at("file", "is empty: give the STL file of the closed surface");
+        for (const std::string_view key : {"spacing", "spacing_z", "lattice_neighbours"}) {
+            if (!surface && r.has(key)) {
+                r.fail_at(key, "does not apply to imported nodes: they have no lattice (their file gives each node's size)");
+            }
+        }
+        b.surface_file = r.required_string("file", what + ", relative to the scene file");
+        if (b.surface_file.empty()) r.fail_at("file", "is empty: give " + what);
         // The unit of the file's numbers: a length unit ("mm") or a length ("25.4 mm").
-        const std::string unit = r.required_string("unit", "the length unit of the STL file's numbers, e.g. \"mm\"");
+        const std::string unit = r.required_string("unit", surface ? "the length unit of the STL file's numbers, e.g. \"mm\""
+                                                                    : "the length unit of the positions (sizes in its square "
+                                                                      "or cube), e.g. \"mm\"");
         std::optional<double> metres;
         for (const std::string& text : {unit, "1 " + unit}) {
             if (metres) break;
@@ -274,9 +290,12 @@ BodySpec read_body(const Reporter& reporter, const toml::table& table, std::size
     } else if (b.shape == ShapeKind::Sphere && r.has("length")) {
         r.fail_at("length", "does not apply to a sphere (give radius or diameter)");
     }
-    if (b.shape != ShapeKind::Surface) {
+    if (!imported) {
         for (const std::string_view key : {"file", "unit"}) {
-            if (r.has(key)) r.fail_at(key, fmt::format("applies to a surface only (shape = \"surface\"), not a {}", shape_name));
+            if (r.has(key)) {
+                r.fail_at(key, fmt::format("applies to a surface or imported nodes only (shape = \"surface\" or \"nodes\"), "
+                                           "not a {}", shape_name));
+            }
         }
     }
     if (r.has("inner_radius")) {
@@ -327,7 +346,7 @@ BodySpec read_body(const Reporter& reporter, const toml::table& table, std::size
         b.nose = n;
     }
 
-    b.spacing = r.required_quantity("spacing", D::Length, Limit::Positive);
+    if (b.shape != ShapeKind::Nodes) b.spacing = r.required_quantity("spacing", D::Length, Limit::Positive);
     if (r.has("spacing_z")) {
         if (dim == 3) r.fail_at("spacing_z", "applies to 2D scenes only: a 3D lattice has one spacing in every direction");
         b.spacing_z = *r.quantity("spacing_z", D::Length, Limit::Positive);
@@ -751,7 +770,7 @@ Scene read_scene(std::string_view text, const Reporter& reporter, std::vector<st
     read_reference(reporter, sub_table(top, "reference", empty), scene);
     // The neighbourhood of local peaks is fixed by the scene as written (twice its first body's
     // spacing unless given), so that the refined runs of a study measure over the same one.
-    if (scene.output.peak_radius == 0.0 && !scene.bodies.empty()) scene.output.peak_radius = 2.0 * scene.bodies.front().spacing;
+    if (scene.output.peak_radius == 0.0 && !scene.bodies.empty()) scene.output.peak_radius = 2.0 * nominal_spacing(scene.bodies.front());
     return scene;
 }
 
@@ -800,7 +819,7 @@ std::string read_scene_text(const std::filesystem::path& file) {
     return text;
 }
 
-std::string resolve_scene_files(Scene& scene, const std::filesystem::path& scene_file) {
+std::string resolve_scene_files(Scene& scene, const std::filesystem::path& scene_file, const MemoryLimit& memory) {
     // The surfaces of bodies of shape "surface": read, checked and made ready for their inside test.
     for (std::size_t k = 0; k < scene.bodies.size(); ++k) {
         BodySpec& b = scene.bodies[k];
@@ -815,6 +834,25 @@ std::string resolve_scene_files(Scene& scene, const std::filesystem::path& scene
         } catch (const std::bad_alloc&) {
             throw InputError(fmt::format("{}: body[{}] \"{}\".file: {}: not enough memory to read it and make its inside test",
                                          scene_file.string(), k, b.name, file.string()));
+        }
+    }
+    // The nodes of bodies of shape "nodes": read and checked.
+    for (std::size_t k = 0; k < scene.bodies.size(); ++k) {
+        BodySpec& b = scene.bodies[k];
+        if (b.shape != ShapeKind::Nodes || b.node_set) continue;
+        const std::filesystem::path file = std::filesystem::path(b.surface_file).is_relative()
+                                               ? (scene_file.parent_path() / b.surface_file).lexically_normal()
+                                               : std::filesystem::path(b.surface_file);
+        try {
+            auto set = std::make_shared<const NodeSet>(read_node_file(file, b.surface_unit, scene.geometry, memory));
+            b.node_set = std::make_shared<const NodeSetShape>(std::move(set), dimension_of(scene.geometry));
+        } catch (const LimitError& e) {
+            throw LimitError(fmt::format("{}: body[{}] \"{}\".file: {}", scene_file.string(), k, b.name, e.what()));
+        } catch (const InputError& e) {
+            throw InputError(fmt::format("{}: body[{}] \"{}\".file: {}", scene_file.string(), k, b.name, e.what()));
+        } catch (const std::bad_alloc&) {
+            throw InputError(fmt::format("{}: body[{}] \"{}\".file: {}: not enough memory to read its nodes", scene_file.string(),
+                                         k, b.name, file.string()));
         }
     }
     if (scene.element_reference.empty()) return {};
@@ -835,9 +873,19 @@ std::string resolve_scene_files(Scene& scene, const std::filesystem::path& scene
     return {};
 }
 
-Scene load_scene(const std::filesystem::path& file, std::string* warning) {
+Scene load_scene(const std::filesystem::path& file, std::string* warning, const MemoryLimit& memory) {
     Scene scene = parse_scene(read_scene_text(file), file.string());
-    std::string w = resolve_scene_files(scene, file);
+    std::string w = resolve_scene_files(scene, file, memory);
+    // The checks that wait for the shapes of imported bodies (overlaps, planes, regions), now that
+    // their files are read.
+    if (std::any_of(scene.bodies.begin(), scene.bodies.end(),
+                    [](const BodySpec& b) { return b.shape == ShapeKind::Surface || b.shape == ShapeKind::Nodes; })) {
+        try {
+            validate_scene(scene);
+        } catch (const InputError& e) {
+            Reporter(file.string()).fail(0, "", e.what());
+        }
+    }
     if (warning) *warning = std::move(w);
     return scene;
 }

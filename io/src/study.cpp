@@ -422,6 +422,10 @@ void apply_variant(const Variant& variant, Scene& scene) {
 Scene refined(const Scene& scene, double factor) {
     Scene s = scene;
     for (auto& b : s.bodies) {
+        if (b.shape == ShapeKind::Nodes && factor != 1.0) {
+            throw InputError(fmt::format("body \"{}\": its nodes are imported, so a refinement cannot divide its spacing; "
+                                         "import each resolution as its own scene", b.name));
+        }
         b.spacing /= factor;
         if (b.spacing_z > 0.0) b.spacing_z /= factor;
     }
@@ -430,6 +434,7 @@ Scene refined(const Scene& scene, double factor) {
 
 double lattice_cell_size(const Scene& scene) {
     if (scene.bodies.empty()) return nan;
+    if (scene.bodies[0].shape == ShapeKind::Nodes) return nominal_spacing(scene.bodies[0]);
     const auto block = body_lattice(scene, 0);
     const int dim = dimension_of(scene.geometry);
     double log_sum = 0.0;

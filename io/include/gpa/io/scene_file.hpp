@@ -10,6 +10,7 @@
 #include <string_view>
 
 #include "gpa/engine/errors.hpp"
+#include "gpa/engine/limits.hpp"
 #include "gpa/engine/scene.hpp"
 
 namespace gpa::io {
@@ -24,7 +25,7 @@ public:
 // Reads and parses a scene file, then resolves the files it names (resolve_scene_files). Messages
 // name the file as given. Throws SceneError (also when the file cannot be read); the warning of
 // resolve_scene_files goes to *warning when given.
-Scene load_scene(const std::filesystem::path& file, std::string* warning = nullptr);
+Scene load_scene(const std::filesystem::path& file, std::string* warning = nullptr, const MemoryLimit& memory = {});
 
 // Makes the relative file names of a parsed scene (`[reference] elements`) relative to the folder
 // of `scene_file`, the file the text came from, and checks them. A reference that is not there is
@@ -32,7 +33,9 @@ Scene load_scene(const std::filesystem::path& file, std::string* warning = nullp
 // returned warning names it and says that the run will not be compared with it (empty when all is
 // there). A reference that is there but cannot be read (a folder, an empty or malformed file) is
 // refused at once, naming the key, rather than at the end of the run: InputError.
-std::string resolve_scene_files(Scene& scene, const std::filesystem::path& scene_file);
+// Bodies of shape "surface" and "nodes" get their STL and node files read here, within `memory`
+// (LimitError, naming the body and the file, when one would not fit).
+std::string resolve_scene_files(Scene& scene, const std::filesystem::path& scene_file, const MemoryLimit& memory = {});
 
 // The bytes of a scene file, read with the scene-size limit (16 MiB) whatever the file is: a
 // device or a pipe that never ends is refused once it passes the limit. Throws SceneError.

@@ -118,7 +118,8 @@ std::string variant_keys_help();
 // body. Throws InputError naming the variant.
 void apply_variant(const Variant& variant, Scene& scene);
 
-// The scene with every body's spacing (and spacing_z) divided by `factor`.
+// The scene with every body's spacing (and spacing_z) divided by `factor`. Throws InputError for a
+// body of imported nodes (factor other than 1).
 Scene refined(const Scene& scene, double factor);
 
 // The resolution a study reports for a scene: the cell size of its first body's lattice as the
