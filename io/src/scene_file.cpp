@@ -849,9 +849,9 @@ std::string resolve_scene_files(Scene& scene, const std::filesystem::path& scene
         } catch (const LimitError& e) {
             throw LimitError(fmt::format("{}: body[{}] \"{}\".file: {}", scene_file.string(), k, b.name, e.what()));
         } catch (const InputError& e) {
-            throw InputError(fmt::format("{}: body[{}] \"{}\".file: {}", scene_file.string(), k, b.name, e.what()));
+            throw SceneError(fmt::format("{}: body[{}] \"{}\".file: {}", scene_file.string(), k, b.name, e.what()));
         } catch (const std::bad_alloc&) {
-            throw InputError(fmt::format("{}: body[{}] \"{}\".file: {}: not enough memory to read its nodes", scene_file.string(),
+            throw SceneError(fmt::format("{}: body[{}] \"{}\".file: {}: not enough memory to read its nodes", scene_file.string(),
                                          k, b.name, file.string()));
         }
     }
