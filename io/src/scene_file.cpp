@@ -830,9 +830,9 @@ std::string resolve_scene_files(Scene& scene, const std::filesystem::path& scene
         try {
             b.surface = std::make_shared<SurfaceInside>(std::make_shared<TriangleSurface>(read_stl(file, b.surface_unit)));
         } catch (const InputError& e) {
-            throw InputError(fmt::format("{}: body[{}] \"{}\".file: {}", scene_file.string(), k, b.name, e.what()));
+            throw SceneError(fmt::format("{}: body[{}] \"{}\".file: {}", scene_file.string(), k, b.name, e.what()));
         } catch (const std::bad_alloc&) {
-            throw InputError(fmt::format("{}: body[{}] \"{}\".file: {}: not enough memory to read it and make its inside test",
+            throw SceneError(fmt::format("{}: body[{}] \"{}\".file: {}: not enough memory to read it and make its inside test",
                                          scene_file.string(), k, b.name, file.string()));
         }
     }
