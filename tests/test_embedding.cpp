@@ -442,6 +442,65 @@ TEST(RunLoopLibrary, WarningsGoToTheCallbackOrAreKept) {
     fs::remove_all(folder);
 }
 
+// Warnings of the steps: an automatic Armco bar whose threshold is never reached (as in
+// LatticeCells.CollapsedCellsOfAnAutomaticBodySwitchAtOnce) switches the nodes of its collapsed
+// impact-face cells; each step that does is told to the hook, or kept with the set-up's warnings.
+TEST(RunLoopLibrary, StepWarningsGoToTheirHookOrAreKept) {
+    io::SceneSource source;
+    source.name = source.label = "collapse.toml";
+    source.text = R"(
+name = "collapse"
+geometry = "axisymmetric"
+[[body]]
+name = "cylinder"
+shape = "cylinder"
+material = "Armco iron"
+radius = "5.1 mm"
+length = "15.2 mm"
+spacing = "0.85 mm"
+velocity = [0, "-305 m/s"]
+[[plane]]
+name = "anvil"
+kind = "rigid"
+axis = "z"
+position = 0
+lift_off = false
+[solver]
+connectivity = "automatic"
+switch_plastic_strain = 100
+viscosity = "nodal"
+[stop]
+end_time = "20 us"
+[output]
+snapshots = 0
+)";
+    const fs::path folder = scratch("step_warnings");
+    std::vector<std::string> told;
+    std::size_t switched = 0;
+    {
+        io::RunLoop run(source, settings_for(folder));
+        io::RunHooks hooks;
+        hooks.step_warning = [&](const std::string& w) { told.push_back(w); };
+        hooks.after_step = [&](Simulation& sim) { switched += sim.totals().collapse_switches; };
+        ASSERT_EQ(run.run(hooks).status, io::RunStatus::Finished);
+        EXPECT_TRUE(run.warnings().empty());
+    }
+    ASSERT_FALSE(told.empty()) << "no lattice cell collapsed: the test needs another case";
+    EXPECT_NE(told[0].find("switched to variable connectivity because a lattice cell collapsed; first: body \"cylinder\", node "),
+              std::string::npos) << told[0];
+    EXPECT_EQ(told[0].rfind("step ", 0), 0u) << told[0];
+    std::size_t counted = 0;  // the messages' counts add up to the switches of the steps
+    for (const std::string& w : told) counted += std::stoul(w.substr(w.find(": ") + 2));
+    EXPECT_EQ(counted, switched);
+    // Without the hook they join the set-up's warnings.
+    io::RunSettings settings = settings_for(folder);
+    settings.overwrite = true;
+    io::RunLoop kept(source, settings);
+    ASSERT_EQ(kept.run().status, io::RunStatus::Finished);
+    EXPECT_EQ(kept.warnings(), told);
+    fs::remove_all(folder);
+}
+
 TEST(RunLoopLibrary, ResumeRefusesAFolderWithoutACheckpointAndAnotherScene) {
     const fs::path folder = scratch("resume");
     fs::create_directories(folder.string() + ".partial");
