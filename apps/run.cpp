@@ -203,7 +203,7 @@ int check_scene(const fs::path& file, const MemoryLimit& memory) {
         std::string held;
         const int dim = dimension_of(scene.geometry);
         for (int c = 0; c < dim; ++c) {
-            if (r.velocity[c]) held += fmt::format("{}{} = {:g} m/s", held.empty() ? "" : ", ", "xyz"[dim == 2 && c == 1 ? 2 : c], *r.velocity[c]);
+            if (r.velocity[c]) held += fmt::format("{}{} = {:g} m/s", held.empty() ? "" : ", ", axis_letter(c, dim), *r.velocity[c]);
         }
         fmt::print("  prescribed velocity \"{}\": {} nodes of body \"{}\" at {}{}\n", r.name, sim.totals().regions[k].nodes, r.body, held,
                    r.ramp > 0.0 ? fmt::format(" after a {:.4g} us ramp", r.ramp * 1e6) : std::string());

@@ -81,8 +81,6 @@ void RunFolder::commit() {
 
 namespace {
 
-char component_letter(int dim, int c) { return dim == 2 ? (c == 0 ? 'x' : 'z') : "xyz"[c]; }
-
 // A unit of an extensive quantity (energy, momentum, force, impulse): per metre of thickness in
 // plane strain, where the bodies are slices of unit thickness.
 std::string extensive(const HistoryLayout& layout, std::string_view unit) {
@@ -97,8 +95,8 @@ std::string body_columns(const Totals& t, const HistoryLayout& layout) {
     for (const auto& b : t.bodies) {
         const std::string& n = b.name;
         h += fmt::format(",{0}_kinetic_energy_{1},{0}_internal_energy_{1}", n, extensive(layout, "J"));
-        for (int c = 0; c < dim; ++c) h += fmt::format(",{}_momentum_{}_{}", n, component_letter(dim, c), extensive(layout, "kg_m_s"));
-        for (int c = 0; c < dim; ++c) h += fmt::format(",{}_velocity_{}_m_s", n, component_letter(dim, c));
+        for (int c = 0; c < dim; ++c) h += fmt::format(",{}_momentum_{}_{}", n, axis_letter(c, dim), extensive(layout, "kg_m_s"));
+        for (int c = 0; c < dim; ++c) h += fmt::format(",{}_velocity_{}_m_s", n, axis_letter(c, dim));
         h += fmt::format(",{0}_residual_velocity_m_s,{0}_pieces,{0}_failed_nodes", n);
         if (b.target) h += fmt::format(",{0}_crater_depth_m,{0}_crater_diameter_m,{0}_perforated", n);
     }
@@ -124,7 +122,7 @@ std::string history_header(const Totals& first, const HistoryLayout& layout) {
     std::string header = fmt::format("time_s,dt_s,step,kinetic_energy_{0},internal_energy_{0},plastic_work_{0},viscous_work_{0},"
                                      "boundary_work_{0},total_energy_error_percent,hourglass_work_{0},hourglass_energy_{0}",
                                      J);
-    for (int c = 0; c < dim; ++c) header += fmt::format(",momentum_{}_{}", component_letter(dim, c), extensive(layout, "kg_m_s"));
+    for (int c = 0; c < dim; ++c) header += fmt::format(",momentum_{}_{}", axis_letter(c, dim), extensive(layout, "kg_m_s"));
     if (layout.specimen) header += ",length_m,footprint_diameter_m,base_height_m";
     // Local peaks (measure.hpp): the neighbourhood peak, where it is, the largest single value.
     for (const char* field : {"plastic_strain", "temperature_K"}) {
@@ -132,7 +130,7 @@ std::string history_header(const Totals& first, const HistoryLayout& layout) {
         const std::string stem = name.substr(0, name.find("_K"));
         const std::string unit = name.size() > stem.size() ? "_K" : "";
         header += fmt::format(",peak_{}{}", stem, unit);
-        for (int c = 0; c < dim; ++c) header += fmt::format(",peak_{}_{}_m", stem, component_letter(dim, c));
+        for (int c = 0; c < dim; ++c) header += fmt::format(",peak_{}_{}_m", stem, axis_letter(c, dim));
         header += fmt::format(",max_{}{}", stem, unit);
     }
     if (layout.specimen) header += ",face_plastic_strain_roughness";
@@ -146,7 +144,7 @@ std::string history_header(const Totals& first, const HistoryLayout& layout) {
         for (const char* quantity : {"reaction", "impulse", "displacement"}) {
             const std::string unit = quantity[0] == 'r' ? extensive(layout, "N") : quantity[0] == 'i' ? extensive(layout, "N_s") : "m";
             for (int c = 0; c < dim; ++c) {
-                if (r.held[c]) header += fmt::format(",{}_{}_{}_{}", name, quantity, component_letter(dim, c), unit);
+                if (r.held[c]) header += fmt::format(",{}_{}_{}_{}", name, quantity, axis_letter(c, dim), unit);
             }
         }
         header += fmt::format(",{}_work_{}", name, J);
@@ -605,7 +603,7 @@ void write_summary(const fs::path& file, const Simulation& sim, const RunSummary
         const auto components = [&](const std::array<double, 3>& v) {
             std::string out = "{";
             for (int c = 0; c < dim; ++c) {
-                if (r.held[c]) out += fmt::format("{}\"{}\": {}", out.size() > 1 ? ", " : "", component_letter(dim, c), json_number(v[c]));
+                if (r.held[c]) out += fmt::format("{}\"{}\": {}", out.size() > 1 ? ", " : "", axis_letter(c, dim), json_number(v[c]));
             }
             return out + "}";
         };

@@ -771,7 +771,7 @@ std::string run_report(const Simulation& sim) {
     for (const auto& r : t.regions) {
         std::string reaction;
         for (int c = 0; c < dim; ++c) {
-            if (r.held[c]) reaction += fmt::format(", reaction {} {:.4g} N", "xyz"[dim == 2 && c == 1 ? 2 : c], r.reaction[c]);
+            if (r.held[c]) reaction += fmt::format(", reaction {} {:.4g} N", axis_letter(c, dim), r.reaction[c]);
         }
         fmt::format_to(std::back_inserter(out), "  prescribed velocity \"{}\": work {:.4g} J{}\n", r.name, r.work, reaction);
     }

@@ -168,7 +168,7 @@ LatticeBlock body_lattice(const Scene& scene, std::size_t index) {
         const double cells = (plane.position - block.origin[a]) / block.spacing[a];
         if (std::abs(cells - std::round(cells)) > 1e-6) {
             const double below = block.origin[a] + std::floor(cells) * block.spacing[a];
-            const char* letter = dim == 2 ? (a == 0 ? "x" : "z") : (a == 0 ? "x" : a == 1 ? "y" : "z");
+            const char letter = axis_letter(static_cast<int>(a), dim);
             throw InputError(fmt::format(
                 "plane \"{}\" (plane[{}]) at {} = {} m cuts body \"{}\" between two faces of its lattice's cells ({} = {} m "
                 "and {} m): a symmetry plane through a body must lie on a cell face, so that its ghosts continue the "

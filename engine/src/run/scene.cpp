@@ -49,11 +49,6 @@ bool same_name(std::string_view a, std::string_view b) {
            });
 }
 
-char axis_letter(int axis, int dim) {
-    if (dim == 2) return axis == 0 ? 'x' : 'z';
-    return axis == 0 ? 'x' : axis == 1 ? 'y' : 'z';
-}
-
 // How far a body may reach past a plane at `position` and still be on its side (touching it). For
 // imported nodes a quarter of their median diameter: their extent is that of cubes (squares) of
 // side d0 about them, which need not be the cells they stand for (a cell of dx by dz, dx != dz, is

@@ -14,7 +14,7 @@ namespace gpa {
 
 namespace {
 
-std::string component_name(int dim, int c) { return dim == 2 ? (c == 0 ? "x" : "z") : std::string(1, "xyz"[c]); }
+std::string component_name(int dim, int c) { return std::string(1, axis_letter(c, dim)); }
 
 std::string stress_name(GeometryKind g, int c) {
     if (g == GeometryKind::ThreeD) return std::array<const char*, 6>{"xx", "yy", "zz", "yz", "xz", "xy"}[c];

@@ -710,7 +710,7 @@ void Simulation::set_velocity(std::uint64_t id, const std::array<double, 3>& vel
             if (spec.velocity[c] && velocity[c] != im.nodes.velocity[c][i]) {
                 throw InputError(fmt::format("Simulation::set_velocity: node id {} is held along {} by the prescribed-velocity "
                                              "region \"{}\" (set the region's velocity with set_region_velocity)",
-                                             id, "xyz"[im.dim() == 2 && c == 1 ? 2 : c], spec.name));
+                                             id, axis_letter(c, im.dim()), spec.name));
             }
         }
     }
@@ -743,7 +743,7 @@ void Simulation::set_region_velocity(std::string_view name, const std::array<dou
         if (!it->velocity[c] && velocity[c] != 0.0) {
             throw InputError(fmt::format("Simulation::set_region_velocity: region \"{}\" leaves component {} free; it holds only the "
                                          "components its scene gives",
-                                         name, "xyz"[im.dim() == 2 && c == 1 ? 2 : c]));
+                                         name, axis_letter(c, im.dim())));
         }
     }
     // From now on: the value replaces the scene's (and its ramp, which is over).

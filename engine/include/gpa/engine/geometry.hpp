@@ -37,6 +37,12 @@ struct ThreeD {
 
 constexpr int dimension_of(GeometryKind g) { return g == GeometryKind::ThreeD ? 3 : 2; }
 
+// The letter of component `axis` in messages and file headers: x, z in 2D; x, y, z in 3D.
+constexpr char axis_letter(int axis, int dim) {
+    if (dim == 2) return axis == 0 ? 'x' : 'z';
+    return axis == 0 ? 'x' : axis == 1 ? 'y' : 'z';
+}
+
 // Number of stored components of a symmetric stress tensor (see the order above).
 constexpr int stress_components(int dim) { return dim == 3 ? 6 : 4; }
 
