@@ -1,5 +1,6 @@
 #include "gpa/io/stl.hpp"
 
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -46,7 +47,7 @@ private:
     std::map<std::array<double, 3>, std::uint32_t> index_;
 };
 
-void read_binary(const std::string& bytes, SurfaceBuilder& out, const std::string& what) {
+void read_binary(std::string_view bytes, SurfaceBuilder& out, const std::string& what) {
     std::uint32_t count = 0;
     std::memcpy(&count, bytes.data() + 80, 4);
     for (std::size_t t = 0; t < count; ++t) {
@@ -67,7 +68,7 @@ void read_binary(const std::string& bytes, SurfaceBuilder& out, const std::strin
 // ASCII STL read as words (any whitespace, CR or LF line ends): "solid [name]" up to its line's
 // end, then per facet "facet normal nx ny nz", "outer loop", three "vertex x y z", "endloop",
 // "endfacet", and "endsolid [name]" (another solid may follow). Messages give the line.
-void read_ascii(const std::string& text, SurfaceBuilder& out, const std::string& what) {
+void read_ascii(std::string_view text, SurfaceBuilder& out, const std::string& what) {
     std::size_t at = text.rfind("\xEF\xBB\xBF", 0) == 0 ? 3 : 0, line = 1;
     const auto fail = [&](const std::string& why) { throw InputError(fmt::format("{}:{}: {}", what, line, why)); };
     const auto space = [](char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\f' || c == '\v'; };
@@ -79,7 +80,7 @@ void read_ascii(const std::string& text, SurfaceBuilder& out, const std::string&
         }
         const std::size_t start = at;
         while (at < text.size() && !space(text[at])) ++at;
-        return std::string_view(text).substr(start, at - start);
+        return text.substr(start, at - start);
     };
     const auto rest_of_line = [&] {
         while (at < text.size() && text[at] != '\n' && text[at] != '\r') ++at;
@@ -125,25 +126,37 @@ void read_ascii(const std::string& text, SurfaceBuilder& out, const std::string&
     if (in_solid) throw InputError(fmt::format("{}: no \"endsolid\": the file is cut short", what));
 }
 
+// The largest file either form may be: a binary one of max_stl_triangles triangles (and a byte to spare).
+constexpr std::uint64_t max_stl_bytes = 84 + 50 * std::uint64_t(max_stl_triangles) + 1;
+
+std::string too_large(const std::string& what) {
+    return fmt::format("{}: is too large (an STL file holds at most {} triangles)", what, max_stl_triangles);
+}
+
 }  // namespace
 
 TriangleSurface read_stl(const std::filesystem::path& file, double unit) {
     const std::string what = file.string();
-    if (!(unit > 0.0) || !std::isfinite(unit)) throw InputError(fmt::format("{}: its unit {} m must be a positive length", what, unit));
     std::error_code ec;
     if (!std::filesystem::is_regular_file(file, ec)) throw InputError(fmt::format("{}: no such STL file", what));
+    // The size before reading, so that a huge file is refused without reading it.
     const auto size = std::filesystem::file_size(file, ec);
-    if (ec || size > 84 + 50 * std::uint64_t(max_stl_triangles) + 1) {
-        throw InputError(fmt::format("{}: {} (an STL file holds at most {} triangles)", what, ec ? "cannot be read" : "is too large",
-                                     max_stl_triangles));
-    }
+    if (ec) throw InputError(fmt::format("{}: cannot be read", what));
+    if (size > max_stl_bytes) throw InputError(too_large(what));
     std::ifstream in(file, std::ios::binary);
     std::string bytes(static_cast<std::size_t>(size), '\0');
     if (!in || !in.read(bytes.data(), static_cast<std::streamsize>(size))) throw InputError(fmt::format("{}: cannot be read", what));
+    return parse_stl(bytes, what, unit);
+}
+
+TriangleSurface parse_stl(std::string_view bytes, const std::string& what, double unit) {
+    if (!(unit > 0.0) || !std::isfinite(unit)) throw InputError(fmt::format("{}: its unit {} m must be a positive length", what, unit));
+    if (bytes.size() > max_stl_bytes) throw InputError(too_large(what));
+    const std::uint64_t size = bytes.size();
     SurfaceBuilder out(unit, what);
     std::uint32_t count = 0;
     if (size >= 84) std::memcpy(&count, bytes.data() + 80, 4);
-    const bool text = bytes.find('\0') == std::string::npos;  // a binary file has zeros
+    const bool text = bytes.find('\0') == std::string_view::npos;  // a binary file has zeros
     const std::size_t skip = bytes.rfind("\xEF\xBB\xBF", 0) == 0 ? 3 : 0;  // a UTF-8 byte-order mark
     if (size >= 84 && size == 84 + 50 * std::uint64_t(count) && !(text && bytes.compare(skip, 5, "solid") == 0)) {
         read_binary(bytes, out, what);

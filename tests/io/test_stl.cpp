@@ -8,6 +8,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -146,6 +147,86 @@ TEST(Stl, CutShortMalformedAndOpenFilesAreRefusedNamingTheFileAndTheLine) {
     EXPECT_NE(refusal(write("cube_ascii.stl", ascii_stl(facets)), -1.0).find("must be a positive length"), std::string::npos);
 }
 
+// read_stl reads the file and hands its bytes to parse_stl: the same surface, and the same
+// refusals naming whatever name the bytes are given.
+TEST(Stl, TheBytesOfAFileReadToTheSameSurfaceAsTheFileUnderTheNameGiven) {
+    const auto facets = cube_facets(4.0f);
+    for (const std::string& bytes : {ascii_stl(facets), binary_stl(facets)}) {
+        const TriangleSurface from_file = read_stl(write("bytes.stl", bytes), 1e-3);
+        const TriangleSurface from_bytes = parse_stl(bytes, "in memory", 1e-3);
+        EXPECT_EQ(from_bytes.vertices, from_file.vertices);
+        EXPECT_EQ(from_bytes.triangles, from_file.triangles);
+    }
+    const std::string text = ascii_stl(facets);
+    const std::string bad = std::string(text).replace(text.find("vertex 0 0 0") + 9, 1, "x");
+    try {
+        (void)parse_stl(bad, "in memory", 1e-3);
+        ADD_FAILURE() << "a malformed number read";
+    } catch (const InputError& e) {
+        EXPECT_EQ(std::string(e.what()), "in memory:4: \"x\" is not a finite number");
+    }
+    EXPECT_THROW((void)parse_stl(text, "in memory", 0.0), InputError);
+}
+
+// Found by reading the reader while writing its fuzz target (tests/fuzz/fuzz_stl.cpp), which then
+// ran them under the sanitizers; the fuzzing itself did not reach them in 4.4 million inputs.
+// Closed surfaces whose box along an axis was wider than a double holds (vertices at +-1.7e308 m:
+// an infinite bucket size) or narrower than the smallest normal double without being flat (a
+// vertex at x = 4.9e-324 m: a bucket size of 0) passed check_surface, and SurfaceInside then took
+// a bucket from a NaN (undefined behaviour). check_surface refuses them naming the axis; a flat
+// surface (a width of 0) and a tiny one still read.
+TEST(Stl, ASurfaceTooWideOrTooThinForTheInsideTestIsRefusedNamingTheAxis) {
+    // A tetrahedron's ASCII text with the corner (1, 1, 1) at (x, 1, 1).
+    const auto tetra = [](const std::string& x) {
+        const std::string d = x + " 1 1";
+        const std::array<std::array<std::string, 3>, 4> facets{{{"0 0 0", "0 0 1", "0 1 0"},
+                                                                {"0 0 0", "0 1 0", d},
+                                                                {"0 0 0", d, "0 0 1"},
+                                                                {"0 1 0", "0 0 1", d}}};
+        std::string out = "solid t\n";
+        for (const auto& f : facets) out += fmt::format("facet normal 0 0 0 outer loop vertex {} vertex {} vertex {} endloop endfacet\n", f[0], f[1], f[2]);
+        return out + "endsolid t\n";
+    };
+    const auto refusal_of = [](const std::string& bytes) {
+        try {
+            (void)parse_stl(bytes, "t.stl", 1.0);
+        } catch (const InputError& e) {
+            return std::string(e.what());
+        }
+        return std::string();
+    };
+    const std::string thin = refusal_of(tetra("4.9e-324"));
+    EXPECT_NE(thin.find("t.stl: along x its vertices reach from 0 to 5e-324 m: too close together"), std::string::npos) << thin;
+    // An octahedron from -1.7e308 to 1.7e308 along x: every edge's length a double still holds.
+    std::string wide = "solid o\n";
+    for (const int sx : {1, -1}) {
+        for (const int sy : {1, -1}) {
+            for (const int sz : {1, -1}) {
+                std::array<std::string, 3> c{fmt::format("{}1.7e308 0 0", sx < 0 ? "-" : ""), fmt::format("0 {} 0", sy),
+                                             fmt::format("0 0 {}", sz)};
+                if (sx * sy * sz < 0) std::swap(c[1], c[2]);  // outward
+                wide += fmt::format("facet normal 0 0 0 outer loop vertex {} vertex {} vertex {} endloop endfacet\n", c[0], c[1], c[2]);
+            }
+        }
+    }
+    wide += "endsolid o\n";
+    const std::string far = refusal_of(wide);
+    EXPECT_NE(far.find("t.stl: along x its vertices reach from -1.7e+308 to 1.7e+308 m: too far apart"), std::string::npos) << far;
+
+    // Within the limits: a tetrahedron 1e-300 m wide along x, and one flat in x (its four faces in
+    // the plane x = 0: closed, with nothing inside). Their inside tests answer (the one 1e-300 m
+    // wide either way: it is thinner than the grid its points are snapped to; under the sanitizers
+    // the call is the check), and never inside beyond the box.
+    for (const char* x : {"1e-300", "0"}) {
+        const auto surface = std::make_shared<TriangleSurface>(parse_stl(tetra(x), "t.stl", 1.0));
+        const SurfaceInside inside(surface);
+        const double width = std::stod(x);
+        (void)inside.inside({0.3 * width, 0.6, 0.6});
+        EXPECT_FALSE(inside.inside({2.0 * width + 1e-300, 0.6, 0.6})) << x;
+        EXPECT_FALSE(inside.inside({-1e-300, 0.6, 0.6})) << x;
+    }
+}
+
 // A 3D scene with a 4 mm box and, 10 mm above it, the same cube as a surface in millimetres.
 std::string surface_scene(const std::string& surface_keys) {
     return fmt::format(R"(
@@ -242,7 +323,7 @@ TEST(Stl, TheSceneReaderRefusesASurfaceWithoutItsFileOrWithTheKeysOfOtherShapes)
     expect("shape = \"surface\"\nfile = \"cube.stl\"", "unit");
     expect("shape = \"surface\"\nfile = \"cube.stl\"\nunit = \"furlong\"", "\"furlong\" is not a length unit");
     expect("shape = \"surface\"\nfile = \"cube.stl\"\nunit = \"mm\"\nradius = \"1 mm\"", "does not apply to a surface");
-    expect("shape = \"box\"\nsize = [\"1 mm\", \"1 mm\", \"1 mm\"]\nfile = \"cube.stl\"", "applies to a surface only");
+    expect("shape = \"box\"\nsize = [\"1 mm\", \"1 mm\", \"1 mm\"]\nfile = \"cube.stl\"", "applies to a surface or imported nodes only");
     const std::string plane = scene_refusal(R"(
 geometry = "plane-strain"
 [[body]]

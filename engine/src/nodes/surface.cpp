@@ -1,8 +1,10 @@
 #include "gpa/engine/surface.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <map>
 #include <utility>
 
@@ -63,6 +65,27 @@ void check_surface(const TriangleSurface& s, const std::string& what) {
     for (std::size_t v = 0; v < s.vertices.size(); ++v) {
         for (const double c : s.vertices[v]) {
             if (!std::isfinite(c)) throw InputError(fmt::format("{}: vertex {} is not finite {}", what, v, point_text(s.vertices[v])));
+        }
+    }
+    // The inside test (SurfaceInside) cuts the surface's box into buckets along x and y and snaps
+    // points to a grid across its largest extent: along each axis the box must be finite and, unless
+    // flat, at least the smallest normal double wide, or a bucket's size comes out infinite or zero
+    // and a point's bucket not a number.
+    if (!s.vertices.empty()) {
+        std::array<double, 3> lo = s.vertices.front(), hi = lo;
+        for (const auto& v : s.vertices) {
+            for (std::size_t c = 0; c < 3; ++c) {
+                lo[c] = std::min(lo[c], v[c]);
+                hi[c] = std::max(hi[c], v[c]);
+            }
+        }
+        for (std::size_t c = 0; c < 3; ++c) {
+            const double width = hi[c] - lo[c];
+            if (std::isfinite(width) && !(width > 0.0 && width < std::numeric_limits<double>::min())) continue;
+            throw InputError(fmt::format("{}: along {} its vertices reach from {} to {} m: too {} for the inside test, which "
+                                         "needs a width of 0 or from {:.3g} to {:.3g} m",
+                                         what, "xyz"[c], lo[c], hi[c], std::isfinite(width) ? "close together" : "far apart",
+                                         std::numeric_limits<double>::min(), std::numeric_limits<double>::max()));
         }
     }
     std::map<std::pair<std::uint32_t, std::uint32_t>, std::uint32_t> edges;  // undirected edge -> triangles sharing it
