@@ -168,6 +168,17 @@ TEST(NodeSet, DuplicateMisplacedAndSizelessNodesAreRefusedNamingThem) {
     not_finite.positions[0][1] = std::nan("");
     EXPECT_NE(refusal(not_finite, 3, false).find("line 2: its y is not a finite number"), std::string::npos);
     EXPECT_NE(refusal(NodeSet{}, 3, false).find("holds no node"), std::string::npos);
+    NodeSet far = good;
+    far.positions[1][0] = 2e9;  // a unit gone wrong
+    EXPECT_NE(refusal(far, 2, false).find("line 3: its x is 2000000000 m, beyond the 1e+09 m"), std::string::npos)
+        << refusal(far, 2, false);
+    NodeSet speck = good;
+    speck.positions[1][0] = 1e3;
+    speck.sizes[1] = 1e-20;  // 1e-10 m across, 1 km out
+    EXPECT_NE(refusal(speck, 2, false).find("line 3: its area 1e-20 gives a diameter of 1e-10 m, below a 10^12th"), std::string::npos)
+        << refusal(speck, 2, false);
+    speck.sizes[1] = 1e-17;  // 3.2e-9 m across: resolved
+    EXPECT_EQ(refusal(speck, 2, false), "");
     NodeSet unpaired = good;
     unpaired.sizes.pop_back();
     EXPECT_NE(refusal(unpaired, 3, false).find("2 positions but 1 sizes"), std::string::npos);

@@ -78,8 +78,11 @@ NodeSetShape::NodeSetShape(std::shared_ptr<const NodeSet> set, int dim) : set_(s
     std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(n / 2), sorted.end());
     typical_ = sorted[n / 2];
     // Buckets as large as the largest node: a point covered by node k, and a node closer to k than
-    // k's diameter, lie in k's bucket or in one of its neighbours.
-    bucket_ = largest;
+    // k's diameter, lie in k's bucket or in one of its neighbours. And no more than 2^20 of them
+    // across the box, so that a bucket's index stays a small integer whatever the sizes.
+    double span = 0.0;
+    for (int c = 0; c < dim_; ++c) span = std::max(span, upper_[c] - lower_[c]);
+    bucket_ = std::max(largest, std::ldexp(span, -20));
     std::vector<Cell> cells(n);
     for (std::size_t k = 0; k < n; ++k) cells[k] = cell_of(set_->positions[k]);
     order_.resize(n);
@@ -126,6 +129,12 @@ void check_node_set(const NodeSet& set, int dim, bool axisymmetric, const std::s
                                              c < dim ? std::string(1, letters[c]) : "third coordinate"));
             }
         }
+        for (int c = 0; c < dim; ++c) {
+            if (std::abs(p[c]) > max_node_coordinate) {
+                throw InputError(fmt::format("{}: {}: its {} is {} m, beyond the {:g} m from the origin a scene may reach", what,
+                                             node_name(set, k), letters[c], p[c], max_node_coordinate));
+            }
+        }
         if (dim == 2 && p[2] != 0.0) {
             throw InputError(fmt::format("{}: {}: a 2D scene's node lies in the x-z plane, but its third coordinate is {} "
                                          "(not 0)", what, node_name(set, k), p[2]));
@@ -137,6 +146,14 @@ void check_node_set(const NodeSet& set, int dim, bool axisymmetric, const std::s
         if (!(set.sizes[k] > 0.0) || !std::isfinite(set.sizes[k])) {
             throw InputError(fmt::format("{}: {}: its {} is {}; it must be positive and finite", what, node_name(set, k),
                                          measure, set.sizes[k]));
+        }
+        // A node smaller than its coordinates resolve (its position has some 16 digits).
+        double distance = 0.0;
+        for (int c = 0; c < dim; ++c) distance = std::max(distance, std::abs(p[c]));
+        if (diameter_of(set.sizes[k], dim) < 1e-12 * distance) {
+            throw InputError(fmt::format("{}: {}: its {} {} gives a diameter of {:.3g} m, below a 10^12th of its distance from the "
+                                         "origin ({:.3g} m), which its coordinates cannot resolve",
+                                         what, node_name(set, k), measure, set.sizes[k], diameter_of(set.sizes[k], dim), distance));
         }
     }
     // Two nodes closer than a quarter of their mean diameter: on a lattice neighbours are a whole

@@ -36,10 +36,14 @@ struct NodeSet {
 
 // The most nodes one body may import (about 3 GB of node data in 3D).
 inline constexpr std::size_t max_imported_nodes = 50'000'000;
+// The farthest a node may lie from the origin along an axis, m (a million km: any larger number
+// is a unit gone wrong, and the bucket grid of NodeSetShape needs a finite box).
+inline constexpr double max_node_coordinate = 1e9;
 
 // Refuses (InputError, naming `what`, e.g. the file, and the node): an empty set, positions and
-// sizes of different counts, a position or size that is not finite, a size <= 0, a 2D node with a
-// third coordinate other than 0, in axisymmetric geometry (`axisymmetric`) a node at x <= 0, more
+// sizes of different counts, a position or size that is not finite, a coordinate beyond
+// max_node_coordinate, a size <= 0, a diameter below 1e-12 of the node's distance from the origin
+// (its coordinates cannot resolve it), a 2D node with a third coordinate other than 0, in axisymmetric geometry (`axisymmetric`) a node at x <= 0, more
 // than max_imported_nodes nodes, and two nodes closer than a quarter of their mean diameter (a
 // node listed twice, or sets that overlap: their pairs would be crushed in the first step).
 void check_node_set(const NodeSet& set, int dim, bool axisymmetric, const std::string& what);
