@@ -828,7 +828,9 @@ std::string resolve_scene_files(Scene& scene, const std::filesystem::path& scene
                                                ? (scene_file.parent_path() / b.surface_file).lexically_normal()
                                                : std::filesystem::path(b.surface_file);
         try {
-            b.surface = std::make_shared<SurfaceInside>(std::make_shared<TriangleSurface>(read_stl(file, b.surface_unit)));
+            b.surface = std::make_shared<SurfaceInside>(std::make_shared<TriangleSurface>(read_stl(file, b.surface_unit, memory)));
+        } catch (const LimitError& e) {
+            throw LimitError(fmt::format("{}: body[{}] \"{}\".file: {}", scene_file.string(), k, b.name, e.what()));
         } catch (const InputError& e) {
             throw SceneError(fmt::format("{}: body[{}] \"{}\".file: {}", scene_file.string(), k, b.name, e.what()));
         } catch (const std::bad_alloc&) {

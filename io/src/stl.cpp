@@ -135,7 +135,7 @@ std::string too_large(const std::string& what) {
 
 }  // namespace
 
-TriangleSurface read_stl(const std::filesystem::path& file, double unit) {
+TriangleSurface read_stl(const std::filesystem::path& file, double unit, const MemoryLimit& memory) {
     const std::string what = file.string();
     std::error_code ec;
     if (!std::filesystem::is_regular_file(file, ec)) throw InputError(fmt::format("{}: no such STL file", what));
@@ -143,6 +143,13 @@ TriangleSurface read_stl(const std::filesystem::path& file, double unit) {
     const auto size = std::filesystem::file_size(file, ec);
     if (ec) throw InputError(fmt::format("{}: cannot be read", what));
     if (size > max_stl_bytes) throw InputError(too_large(what));
+    const double triangles = static_cast<double>(size) / 50.0;
+    const double need = static_cast<double>(size) + triangles * bytes_per_stl_triangle;
+    if (need > static_cast<double>(limit_bytes(memory))) {
+        throw LimitError(fmt::format("{}: its up to {:.4g} triangles ({} bytes) need an estimated {} of memory to read and make "
+                                     "ready for the inside test; {}",
+                                     what, std::floor(triangles), size, format_bytes(need), describe_limit(memory)));
+    }
     std::ifstream in(file, std::ios::binary);
     std::string bytes(static_cast<std::size_t>(size), '\0');
     if (!in || !in.read(bytes.data(), static_cast<std::streamsize>(size))) throw InputError(fmt::format("{}: cannot be read", what));
