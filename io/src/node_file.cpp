@@ -13,6 +13,7 @@
 
 #include "gpa/engine/errors.hpp"
 #include "gpa/io/snapshot_reader.hpp"
+#include "toml_reading.hpp"  // printable: a file's bytes quoted in a message stay one line
 
 namespace gpa::io {
 
@@ -178,6 +179,8 @@ NodeSet parse_node_csv(std::string_view text, const std::string& name, double un
             columns = fields.size();
             std::vector<std::string> names;
             for (const auto f : fields) names.push_back(column_name(f));
+            std::vector<std::string> shown;  // as the message quotes them
+            for (const auto& n : names) shown.push_back(printable(n, 40));
             for (std::size_t w = 0; w < wanted.size(); ++w) {
                 const auto it = std::find(names.begin(), names.end(), wanted[w]);
                 if (it == names.end()) {
@@ -185,7 +188,7 @@ NodeSet parse_node_csv(std::string_view text, const std::string& name, double un
                                                  "{} (the first line that is not blank or a # comment is the header; it "
                                                  "names {})",
                                                  name, line_number, wanted[w], dim == 3 ? "3D" : "2D",
-                                                 fmt::join(wanted, ", "), fmt::join(names, ", ")));
+                                                 fmt::join(wanted, ", "), fmt::join(shown, ", ")));
                 }
                 if (std::find(it + 1, names.end(), wanted[w]) != names.end()) {
                     throw InputError(fmt::format("{}:{}: the header names column \"{}\" twice", name, line_number, wanted[w]));
@@ -206,7 +209,7 @@ NodeSet parse_node_csv(std::string_view text, const std::string& name, double un
             const auto v = number(fields[column[w]]);
             if (!v) {
                 throw InputError(fmt::format("{}:{}: column \"{}\": \"{}\" is not a number", name, line_number, wanted[w],
-                                             trimmed(fields[column[w]]).substr(0, 40)));
+                                             printable(trimmed(fields[column[w]]), 40)));
             }
             if (w + 1 < wanted.size()) {
                 p[w] = *v * scale[0];

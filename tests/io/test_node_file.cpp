@@ -129,6 +129,12 @@ TEST(NodeFile, MalformedTablesAreRefusedNamingTheLineAndTheColumn) {
     EXPECT_NE(csv_refusal(header + "0,0,nan,1\n").find("line 2: its z is not a finite number"), std::string::npos);
     EXPECT_NE(csv_refusal("x,z,area\n0,1,1\n", GeometryKind::Axisymmetric).find("line 2: at x = 0 m"), std::string::npos);
     EXPECT_NE(csv_refusal(header).find("holds no node"), std::string::npos);
+    // The file's bytes quoted in a message are made printable: it stays one line (found by the fuzz
+    // target: a header name with carriage returns inside).
+    const std::string quoted = csv_refusal("x,y\r\r1,z,volume\n") + csv_refusal(header + "0,0,0,1\r\r2\n");
+    EXPECT_EQ(quoted.find('\r'), std::string::npos) << quoted;
+    EXPECT_NE(quoted.find("names x, y\\r\\r1, z, volume"), std::string::npos) << quoted;
+    EXPECT_NE(quoted.find("\"1\\r\\r2\" is not a number"), std::string::npos) << quoted;
     EXPECT_NE(csv_refusal("# only a comment\n").find("holds no header line"), std::string::npos);
     EXPECT_NE(csv_refusal(std::string("x,y,z,volume\n0,0\0,0,1\n", 24)).find("zero byte"), std::string::npos);
     try {
