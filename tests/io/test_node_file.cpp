@@ -188,16 +188,6 @@ std::string block_csv() {
     return out;
 }
 
-std::string node_scene_refusal(const std::string& text, const fs::path& file) {
-    std::ofstream(file) << text;
-    try {
-        (void)load_scene(file);
-    } catch (const InputError& e) {
-        return e.what();
-    }
-    return "";
-}
-
 TEST(NodeFile, TheSceneReaderTakesTheFileBesideTheSceneAndRefusesTheKeysOfLattices) {
     const fs::path folder = node_scratch_folder() / "scene";
     fs::create_directories(folder / "parts");
@@ -222,7 +212,7 @@ TEST(NodeFile, TheSceneReaderTakesTheFileBesideTheSceneAndRefusesTheKeysOfLattic
     EXPECT_LT(std::abs(sim.totals().energy_error), 1e-9);
 
     const auto expect = [&](const std::string& keys, const std::string& words) {
-        const std::string message = node_scene_refusal(nodes_scene(keys), file);
+        const std::string message = testing::scene_file_refusal(nodes_scene(keys), file);
         EXPECT_NE(message.find(words), std::string::npos) << keys << "\n -> " << message;
     };
     const std::string ok = "shape = \"nodes\"\nfile = \"parts/block.csv\"\nunit = \"mm\"\n";

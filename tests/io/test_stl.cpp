@@ -21,6 +21,7 @@
 #include "gpa/io/run_loop.hpp"
 #include "gpa/io/scene_file.hpp"
 #include "gpa/io/stl.hpp"
+#include "support/scenes.hpp"
 
 namespace gpa::io {
 namespace {
@@ -250,16 +251,6 @@ max_steps = 1
 )", surface_keys);
 }
 
-std::string scene_refusal(const std::string& text, const fs::path& file) {
-    std::ofstream(file) << text;
-    try {
-        (void)load_scene(file);
-    } catch (const InputError& e) {
-        return e.what();
-    }
-    return "";
-}
-
 TEST(Stl, ASurfaceBesideTheSceneFillsTheNodesOfTheBoxOfItsSize) {
     const fs::path folder = scratch_folder() / "scene";
     fs::create_directories(folder / "parts");
@@ -338,7 +329,7 @@ TEST(Stl, TheSceneReaderRefusesASurfaceWithoutItsFileOrWithTheKeysOfOtherShapes)
     std::ofstream(folder / "cube.stl", std::ios::binary) << binary_stl(cube_facets(4.0f));
     const fs::path file = folder / "scene.toml";
     const auto expect = [&](const std::string& keys, const std::string& words) {
-        const std::string message = scene_refusal(surface_scene(keys), file);
+        const std::string message = testing::scene_file_refusal(surface_scene(keys), file);
         EXPECT_NE(message.find(words), std::string::npos) << keys << "\n -> " << message;
     };
     expect("shape = \"surface\"\nfile = \"nowhere.stl\"\nunit = \"mm\"", "body[1] \"part\".file: ");
@@ -348,7 +339,7 @@ TEST(Stl, TheSceneReaderRefusesASurfaceWithoutItsFileOrWithTheKeysOfOtherShapes)
     expect("shape = \"surface\"\nfile = \"cube.stl\"\nunit = \"furlong\"", "\"furlong\" is not a length unit");
     expect("shape = \"surface\"\nfile = \"cube.stl\"\nunit = \"mm\"\nradius = \"1 mm\"", "does not apply to a surface");
     expect("shape = \"box\"\nsize = [\"1 mm\", \"1 mm\", \"1 mm\"]\nfile = \"cube.stl\"", "applies to a surface or imported nodes only");
-    const std::string plane = scene_refusal(R"(
+    const std::string plane = testing::scene_file_refusal(R"(
 geometry = "plane-strain"
 [[body]]
 name = "part"

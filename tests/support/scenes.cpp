@@ -1,9 +1,11 @@
 #include "support/scenes.hpp"
 
 #include <cmath>
+#include <fstream>
 #include <sstream>
 
 #include "gpa/engine/state_io.hpp"
+#include "gpa/io/scene_file.hpp"
 
 namespace gpa::testing {
 
@@ -128,6 +130,16 @@ Scene armco_cylinder(int radial_cells, double end_time) {
     s.planes.push_back(wall);
     s.stop.end_time = end_time;
     return s;
+}
+
+std::string scene_file_refusal(const std::string& text, const std::filesystem::path& file) {
+    std::ofstream(file) << text;
+    try {
+        (void)io::load_scene(file);
+    } catch (const InputError& e) {
+        return e.what();
+    }
+    return "";
 }
 
 }  // namespace gpa::testing

@@ -1,6 +1,7 @@
 #pragma once
 // Scenes built in code for the engine's run tests.
 
+#include <filesystem>
 #include <string>
 
 #include "gpa/engine/scene.hpp"
@@ -25,6 +26,10 @@ Scene pulled_elastic_bar(GeometryKind geometry, double radius, double length, in
 // Every field of every node of a run (ghosts included) and the fixed lists, as bytes (the
 // checkpoint encoding of NodeStore): for comparing runs bit for bit.
 std::string node_bytes(const Simulation& sim);
+
+// Writes `text` to `file` and reads it as a scene file (io::load_scene): the error's message, or
+// "" when it reads.
+std::string scene_file_refusal(const std::string& text, const std::filesystem::path& file);
 
 // The paper's Armco-iron cylinder (L0 15.2 mm, D0 10.2 mm, 305 m/s) at `radial_cells` across
 // the radius, nodal viscosity, no lift-off, with the given end time.
