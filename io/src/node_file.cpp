@@ -180,7 +180,7 @@ NodeSet parse_node_csv(std::string_view text, const std::string& name, double un
             std::vector<std::string> names;
             for (const auto f : fields) names.push_back(column_name(f));
             std::vector<std::string> shown;  // as the message quotes them
-            for (const auto& n : names) shown.push_back(printable(n, 40));
+            for (const auto& n : names) shown.push_back(detail::printable(n, 40));
             for (std::size_t w = 0; w < wanted.size(); ++w) {
                 const auto it = std::find(names.begin(), names.end(), wanted[w]);
                 if (it == names.end()) {
@@ -209,7 +209,7 @@ NodeSet parse_node_csv(std::string_view text, const std::string& name, double un
             const auto v = number(fields[column[w]]);
             if (!v) {
                 throw InputError(fmt::format("{}:{}: column \"{}\": \"{}\" is not a number", name, line_number, wanted[w],
-                                             printable(trimmed(fields[column[w]]), 40)));
+                                             detail::printable(trimmed(fields[column[w]]), 40)));
             }
             if (w + 1 < wanted.size()) {
                 p[w] = *v * scale[0];
