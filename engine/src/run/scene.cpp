@@ -471,7 +471,7 @@ void check_plane(const Scene& scene, const PlaneSpec& p, std::size_t i) {
             if (b.shape == ShapeKind::Nodes) {
                 fail(fmt::format("{} at {} = {} m cuts {}, whose nodes are imported: a symmetry plane may cut a body filled "
                                  "with a lattice (it keeps the cells on its side), but imported nodes must all lie on its "
-                                 "side, half a node's diameter or more from it",
+                                 "side, a quarter of their median diameter or more from it",
                                  label, letter, p.position, body_label(b, k)));
             }
             // A half or quarter model: the body is filled on the plane's side (body_lattice), and the
