@@ -136,7 +136,8 @@ TEST(NodeFile, MalformedTablesAreRefusedNamingTheLineAndTheColumn) {
     EXPECT_NE(quoted.find("names x, y\\r\\r1, z, volume"), std::string::npos) << quoted;
     EXPECT_NE(quoted.find("\"1\\r\\r2\" is not a number"), std::string::npos) << quoted;
     EXPECT_NE(csv_refusal("# only a comment\n").find("holds no header line"), std::string::npos);
-    EXPECT_NE(csv_refusal(std::string("x,y,z,volume\n0,0\0,0,1\n", 24)).find("zero byte"), std::string::npos);
+    constexpr char with_zero[] = "x,y,z,volume\n0,0\0,0,1\n";  // a zero byte inside: the array's size less its terminator
+    EXPECT_NE(csv_refusal(std::string(with_zero, sizeof with_zero - 1)).find("part.csv:2: holds a zero byte"), std::string::npos);
     try {
         (void)read_node_file(node_scratch_folder() / "nodes.txt", 1e-3, GeometryKind::ThreeD);
         ADD_FAILURE() << "a .txt node file was read";
