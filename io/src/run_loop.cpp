@@ -144,21 +144,19 @@ std::string surfaces_digest(const Scene& scene) {
         const auto* p = static_cast<const unsigned char*>(data);
         for (std::size_t k = 0; k < bytes; ++k) h = (h ^ p[k]) * 1099511628211ull;
     };
+    const auto add_all = [&](const auto& values) { add(values.data(), values.size() * sizeof(values[0])); };
     for (std::size_t b = 0; b < scene.bodies.size(); ++b) {
-        if (!scene.bodies[b].surface) continue;
+        const BodySpec& body = scene.bodies[b];
+        if (!body.surface && !body.node_set) continue;
         any = true;
-        const TriangleSurface& t = scene.bodies[b].surface->triangles();
         add(&b, sizeof b);
-        add(t.vertices.data(), t.vertices.size() * sizeof(t.vertices[0]));
-        add(t.triangles.data(), t.triangles.size() * sizeof(t.triangles[0]));
-    }
-    for (std::size_t b = 0; b < scene.bodies.size(); ++b) {
-        if (!scene.bodies[b].node_set) continue;
-        any = true;
-        const NodeSet& n = scene.bodies[b].node_set->set();
-        add(&b, sizeof b);
-        add(n.positions.data(), n.positions.size() * sizeof(n.positions[0]));
-        add(n.sizes.data(), n.sizes.size() * sizeof(n.sizes[0]));
+        if (body.surface) {
+            add_all(body.surface->triangles().vertices);
+            add_all(body.surface->triangles().triangles);
+        } else {
+            add_all(body.node_set->set().positions);
+            add_all(body.node_set->set().sizes);
+        }
     }
     return any ? fmt::format("{:016x}", h) : std::string();
 }
