@@ -5,9 +5,11 @@
 
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <numbers>
 #include <filesystem>
 #include <fstream>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -114,6 +116,48 @@ TEST(LocalPeak, AUniformFieldIsItsOwnPeakAndASpikeIsAveraged) {
     EXPECT_NEAR(measure::local_peak(points, 0.12, 2).value, 100.0, 1e-12);
     EXPECT_THROW(measure::local_peak(points, 0.0, 2), std::invalid_argument);
     EXPECT_THROW(measure::local_peak(points, NAN, 2), std::invalid_argument);
+}
+
+TEST(LocalPeak, SeveralFieldsInOnePassAreEachFieldsOwnPeakExactly) {
+    // Points of two bodies scattered over a square, two fields that peak in different places:
+    // local_peaks must give, field by field, local_peak's numbers to the last bit (same sums in
+    // the same order), in 2D and in 3D.
+    for (int dim : {2, 3}) {
+        std::vector<measure::FieldPoint> points;
+        std::vector<double> a, b;
+        std::uint64_t state = 12345;
+        const auto uniform = [&] {
+            state = state * 6364136223846793005ull + 1442695040888963407ull;
+            return double(state >> 11) * 0x1.0p-53;
+        };
+        for (int k = 0; k < 3000; ++k) {
+            measure::FieldPoint p;
+            for (int c = 0; c < dim; ++c) p.position[c] = uniform() - 0.3;
+            p.weight = 0.5 + uniform();
+            p.body = k % 7 == 0 ? 1 : 0;
+            points.push_back(p);
+            a.push_back(std::exp(-8.0 * p.position[0] * p.position[0]) + 0.1 * uniform());
+            b.push_back(p.position[1] + uniform());
+        }
+        const std::array<std::span<const double>, 2> fields{a, b};
+        const auto both = measure::local_peaks(points, fields, 0.07, dim);
+        ASSERT_EQ(both.size(), 2u);
+        for (int f = 0; f < 2; ++f) {
+            for (std::size_t q = 0; q < points.size(); ++q) points[q].value = f == 0 ? a[q] : b[q];
+            const auto one = measure::local_peak(points, 0.07, dim);
+            EXPECT_EQ(both[f].value, one.value);
+            EXPECT_EQ(both[f].position, one.position);
+            EXPECT_EQ(both[f].raw, one.raw);
+            EXPECT_EQ(both[f].raw_position, one.raw_position);
+            EXPECT_EQ(both[f].points, points.size());
+            // A neighbourhood mean is a weighted mean of values: never above the largest one.
+            EXPECT_LE(one.value, one.raw);
+        }
+        EXPECT_NE(both[0].position, both[1].position) << "the two fields peak in different places";
+        const std::vector<double> short_field(points.size() - 1, 0.0);
+        const std::array<std::span<const double>, 1> wrong{short_field};
+        EXPECT_THROW(measure::local_peaks(points, wrong, 0.07, dim), std::invalid_argument);
+    }
 }
 
 TEST(FaceRoughness, ALinearTrendIsSmoothAndAnAlternationIsNot) {

@@ -242,7 +242,9 @@ void Measures::local_fields(const Scene& scene, const NodeStore& nodes, std::siz
     if (!out.measured) return;
     const int d = nodes.dim();
     const int across = plane && plane->axis == 0 ? 1 : 0;
-    std::vector<measure::FieldPoint> strain, heat;
+    // The material points, and their plastic strain and temperature.
+    std::vector<measure::FieldPoint> points;
+    std::vector<double> strain, heat;
     std::vector<double> face_across, face_value;
     // The face row of particles: nodes on the base now that started in the lattice row nearest
     // the plane (below the next row up), so that a second row pressed down does not mix in.
@@ -255,10 +257,9 @@ void Measures::local_fields(const Scene& scene, const NodeStore& nodes, std::siz
         for (int c = 0; c < d; ++c) p.position[c] = nodes.position[c][i];
         p.weight = nodes.size_weight[i];
         p.body = nodes.body[i];
-        p.value = nodes.plastic_strain[i];
-        strain.push_back(p);
-        p.value = nodes.temperature[i];
-        heat.push_back(p);
+        points.push_back(p);
+        strain.push_back(nodes.plastic_strain[i]);
+        heat.push_back(nodes.temperature[i]);
         if (plane && plane->distance(nodes.position[plane->axis][i]) - base_height < measure::particle_cell_size(nodes.size_weight[i], d) &&
             plane->distance(nodes.initial_position[plane->axis][i]) - first_row < 0.5 * nodes.initial_diameter[i]) {
             face_across.push_back(nodes.position[across][i]);
@@ -279,10 +280,9 @@ void Measures::local_fields(const Scene& scene, const NodeStore& nodes, std::siz
                 p.weight = 0.5 * std::abs((m.nodes.position[0][b] - m.nodes.position[0][a]) * (m.nodes.position[1][c] - m.nodes.position[1][a]) -
                                           (m.nodes.position[1][b] - m.nodes.position[1][a]) * (m.nodes.position[0][c] - m.nodes.position[0][a]));
                 p.body = m.quads.body[q];
-                p.value = m.points.plastic_strain[t];
-                strain.push_back(p);
-                p.value = m.points.temperature[t];
-                heat.push_back(p);
+                points.push_back(p);
+                strain.push_back(m.points.plastic_strain[t]);
+                heat.push_back(m.points.temperature[t]);
                 if (plane) {
                     // A triangle whose outer edge lies on the base.
                     const double tol = measure::element_face_tolerance(m.body_spacing[static_cast<std::size_t>(m.quads.body[q])]);
@@ -303,7 +303,7 @@ void Measures::local_fields(const Scene& scene, const NodeStore& nodes, std::siz
     no_plane.axis = -1;
     const std::vector<GhostPlane> mirrors = mirrors_on(plane ? *plane : no_plane);
     if (!mirrors.empty()) {
-        const std::size_t points = strain.size(), face = face_across.size();
+        const std::size_t real_points = points.size(), face = face_across.size();
         for (std::size_t mask = 1; mask < (std::size_t{1} << mirrors.size()); ++mask) {
             const auto image = [&](std::array<double, 3> x) {
                 for (std::size_t k = 0; k < mirrors.size(); ++k) {
@@ -311,11 +311,12 @@ void Measures::local_fields(const Scene& scene, const NodeStore& nodes, std::siz
                 }
                 return x;
             };
-            for (std::size_t q = 0; q < points; ++q) {
-                measure::FieldPoint s = strain[q], t = heat[q];
-                s.position = t.position = image(strain[q].position);
-                strain.push_back(s);
-                heat.push_back(t);
+            for (std::size_t q = 0; q < real_points; ++q) {
+                measure::FieldPoint s = points[q];
+                s.position = image(points[q].position);
+                points.push_back(s);
+                strain.push_back(strain[q]);
+                heat.push_back(heat[q]);
             }
             for (std::size_t q = 0; q < face; ++q) {
                 std::array<double, 3> x{0, 0, 0};
@@ -325,8 +326,10 @@ void Measures::local_fields(const Scene& scene, const NodeStore& nodes, std::siz
             }
         }
     }
-    out.plastic_strain = measure::local_peak(strain, out.radius, d);
-    out.temperature = measure::local_peak(heat, out.radius, d);
+    const std::array<std::span<const double>, 2> fields{strain, heat};
+    const std::vector<measure::LocalPeak> peaks = measure::local_peaks(points, fields, out.radius, d);
+    out.plastic_strain = peaks[0];
+    out.temperature = peaks[1];
     out.face_roughness = measure::face_roughness(face_across, face_value);
     out.face_points = face_value.size();
 }

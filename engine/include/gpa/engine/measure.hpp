@@ -233,6 +233,11 @@ struct LocalPeak {
 // The peak of `points` over neighbourhoods of `radius` (> 0) in `dim` (2 or 3) dimensions.
 // Throws std::invalid_argument for a radius that is not positive and finite.
 LocalPeak local_peak(std::span<const FieldPoint> points, double radius, int dim);
+// The peaks of several fields at the same points, each field a value per point in the order of
+// `points` (whose own `value` is not read): one pass over the neighbourhoods serves them all, and
+// each peak equals local_peak's for that field. Also throws for a field of another length.
+std::vector<LocalPeak> local_peaks(std::span<const FieldPoint> points, std::span<const std::span<const double>> fields,
+                                   double radius, int dim);
 
 // Roughness of a field along the impact face, the measure of node-to-node scatter: the face
 // points ordered by their coordinate across the plane, the mean over the inner ones of
