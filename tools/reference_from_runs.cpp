@@ -5,11 +5,13 @@
 // the series into a reference and the file it writes are those of `gpa study --reference`.
 //
 //   gpa_reference_from_runs SCENE OUT.toml VARIANT FACTOR:RUN_DIR FACTOR:RUN_DIR FACTOR:RUN_DIR...
+#include <array>
 #include <cmath>
 #include <cstdlib>
 #include <cstdio>
 #include <fstream>
 #include <regex>
+#include <span>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -83,7 +85,8 @@ int main(int argc, char** argv) {
             const auto cells = file.cells();
             const auto strain = file.values("plastic_strain", io::DataLocation::Cell);
             const auto heat = file.values("temperature", io::DataLocation::Cell);
-            std::vector<measure::FieldPoint> ps, pt;
+            std::vector<measure::FieldPoint> centroids;
+            std::vector<double> centroid_strain, centroid_heat;
             for (std::size_t t = 0; t < file.cell_count(); ++t) {
                 const std::int64_t begin = t ? cells.offsets[t - 1] : 0;
                 if (cells.offsets[t] - begin != 3) continue;
@@ -95,13 +98,14 @@ int main(int argc, char** argv) {
                 measure::FieldPoint f;
                 f.position = {(x[0][0] + x[1][0] + x[2][0]) / 3, (x[0][1] + x[1][1] + x[2][1]) / 3, 0};
                 f.weight = 0.5 * std::abs((x[1][0] - x[0][0]) * (x[2][1] - x[0][1]) - (x[1][1] - x[0][1]) * (x[2][0] - x[0][0]));
-                f.value = strain[t];
-                ps.push_back(f);
-                f.value = heat[t];
-                pt.push_back(f);
+                centroids.push_back(f);
+                centroid_strain.push_back(strain[t]);
+                centroid_heat.push_back(heat[t]);
             }
-            c.metrics["peak_plastic_strain"] = measure::local_peak(ps, scene.output.peak_radius, 2).value;
-            c.metrics["peak_temperature"] = measure::local_peak(pt, scene.output.peak_radius, 2).value;
+            const std::array<std::span<const double>, 2> fields{centroid_strain, centroid_heat};
+            const auto peaks = measure::local_peaks(centroids, fields, scene.output.peak_radius, 2);
+            c.metrics["peak_plastic_strain"] = peaks[0].value;
+            c.metrics["peak_temperature"] = peaks[1].value;
             std::ifstream prof(dir / "profile.csv");
             std::string line;
             std::getline(prof, line);
