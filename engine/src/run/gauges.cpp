@@ -178,10 +178,11 @@ Gauge::Gauge(const GaugeSpec& spec, const Scene& scene, const NodeStore& nodes, 
     // Each particle body's lattice spacing per axis: a node's cell extends half of it either way.
     std::vector<std::array<double, 3>> spacing(scene.bodies.size(), std::array<double, 3>{0.0, 0.0, 0.0});
     for (std::size_t b = 0; b < scene.bodies.size(); ++b) {
-        const BodySpec& spec = scene.bodies[b];
-        if (spec.shape == ShapeKind::Nodes) {  // imported nodes: their median diameter
-            spacing[b] = {nominal_spacing(spec), nominal_spacing(spec), nominal_spacing(spec)};
-        } else if (spec.discretisation == Discretisation::Particles) {
+        const BodySpec& body_spec = scene.bodies[b];
+        if (body_spec.shape == ShapeKind::Nodes) {  // imported nodes: their median diameter
+            const double d = nominal_spacing(body_spec);
+            spacing[b] = {d, d, d};
+        } else if (body_spec.discretisation == Discretisation::Particles) {
             spacing[b] = body_lattice(scene, b).spacing;
         }
     }
