@@ -19,12 +19,14 @@
 #
 # Settings (environment): ROUNDS (5), THREADS (2), NODES (1e5), CASES ("2d-variable 2d-fixed
 # 3d-variable 3d-fixed"), STEPS (10), WARMUP (20), SCENES (1: run the two whole scenes; 0: skip),
-# COMPARE_DIR (build/compare). Raw output of every round goes to COMPARE_DIR/raw-<base>-<head>/.
+# UNITY (0: the default build, as scripts/run.sh makes it; 1: the unity build of scripts/test.sh
+# and CI, -DGPA_UNITY_BUILD=ON, in build-unity/ beside build/), COMPARE_DIR (build/compare). Raw
+# output of every round goes to COMPARE_DIR/raw-<base>-<head>/ (raw-unity-<base>-<head>/ with UNITY=1).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 top=$(pwd)
 if [[ $# -lt 1 || $# -gt 2 || "$1" == "-h" || "$1" == "--help" ]]; then
-  sed -n '2,20p' "$0" | sed 's/^# \{0,1\}//'
+  sed -n '2,23p' "$0" | sed 's/^# \{0,1\}//'
   [[ $# -ge 1 && ( "$1" == "-h" || "$1" == "--help" ) ]] && exit 0
   exit 2
 fi
@@ -37,6 +39,11 @@ cases=${CASES:-"2d-variable 2d-fixed 3d-variable 3d-fixed"}
 steps=${STEPS:-10}
 warmup=${WARMUP:-20}
 with_scenes=${SCENES:-1}
+case ${UNITY:-0} in
+  0) build_name=build unity_flag=OFF raw_prefix=raw ;;
+  1) build_name=build-unity unity_flag=ON raw_prefix=raw-unity ;;
+  *) echo "compare.sh: UNITY must be 0 or 1, not '${UNITY}'" >&2; exit 2 ;;
+esac
 dir=${COMPARE_DIR:-$top/build/compare}
 
 resolve() {
@@ -48,21 +55,21 @@ command -v python3 >/dev/null || { echo "compare.sh: needs python3 for the table
 
 # Build one commit: its source from git (a detached worktree), its own Release build folder.
 build_commit() {
-  local sha=$1 src="$dir/$1/src" bld="$dir/$1/build"
+  local sha=$1 src="$dir/$1/src" bld="$dir/$1/$build_name"
   mkdir -p "$dir/$sha"
   if [[ ! -d "$src" ]]; then
     git -C "$top" worktree add --detach --force "$src" "$sha" >/dev/null
   fi
-  cmake -S "$src" -B "$bld" -DCMAKE_BUILD_TYPE=Release -DGPA_BUILD_TESTS=OFF -DGPA_BUILD_TOOLS=OFF >"$dir/$sha/cmake.log" 2>&1 ||
-    { echo "compare.sh: cmake failed for $sha (see $dir/$sha/cmake.log)" >&2; exit 1; }
-  cmake --build "$bld" --target gpa_bench_steps gpa_cli -j"$(nproc)" >"$dir/$sha/build.log" 2>&1 ||
-    { echo "compare.sh: the build of $sha failed (see $dir/$sha/build.log)" >&2; exit 1; }
+  cmake -S "$src" -B "$bld" -DCMAKE_BUILD_TYPE=Release -DGPA_UNITY_BUILD=$unity_flag -DGPA_BUILD_TESTS=OFF -DGPA_BUILD_TOOLS=OFF >"$dir/$sha/cmake-$build_name.log" 2>&1 ||
+    { echo "compare.sh: cmake failed for $sha (see $dir/$sha/cmake-$build_name.log)" >&2; exit 1; }
+  cmake --build "$bld" --target gpa_bench_steps gpa_cli -j"$(nproc)" >"$dir/$sha/$build_name.log" 2>&1 ||
+    { echo "compare.sh: the build of $sha failed (see $dir/$sha/$build_name.log)" >&2; exit 1; }
 }
 echo "compare.sh: building $(git -C "$top" rev-parse --short "$base") and $(git -C "$top" rev-parse --short "$head") in $dir"
 build_commit "$base"
 build_commit "$head"
 
-raw="$dir/raw-${base:0:7}-${head:0:7}"
+raw="$dir/$raw_prefix-${base:0:7}-${head:0:7}"
 rm -rf "$raw"
 mkdir -p "$raw"
 case_args=()
@@ -70,7 +77,7 @@ for c in $cases; do case_args+=(--case "$c"); done
 
 # One round of one commit: the step benchmark, then the three scenes, each timed.
 run_round() {
-  local sha=$1 tag=$2 k=$3 bld="$dir/$1/build" src="$dir/$1/src"
+  local sha=$1 tag=$2 k=$3 bld="$dir/$1/$build_name" src="$dir/$1/src"
   (cd "$src" && "$bld/benchmarks/gpa_bench_steps" "${case_args[@]}" --nodes "$nodes" --threads "$threads" \
      --steps "$steps" --warmup "$warmup" --repeat 1) >"$raw/$tag-$k.steps.md"
   if [[ "$with_scenes" == 1 ]]; then
