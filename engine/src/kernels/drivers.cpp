@@ -85,6 +85,41 @@ template <class G, class W>
     throw NumericalError(fmt::format("{}: the velocity gradient is not finite", describe(f.pairs, i)));
 }
 
+// The paper's correction at free surfaces (its section 2.5; kernels.hpp, OneSidedMoments): a
+// second pass over the row, taken only when the option is on, so that the sweep without it is
+// unchanged.
+template <class G, class W, bool full>
+void correct_for_surface(const GradientFields<G::dim>& f, std::span<const NodeIndex> row, std::size_t i,
+                         GradientSums<G::dim>& sums) {
+    constexpr int D = G::dim;
+    if constexpr (full) {
+        Vec<D> first_moment = Vec<D>::Zero();
+        for (NodeIndex j : row) {
+            const auto p = f.pairs.template pair<W>(i, j);
+            first_moment += (p.R * f.size_weight[j]) * p.l;
+        }
+        const double length = first_moment.norm();
+        if (!(length > 0.0)) return;
+        const Vec<D> normal = first_moment / length;
+        double positive = 0.0, negative = 0.0;
+        for (NodeIndex j : row) {
+            const auto p = f.pairs.template pair<W>(i, j);
+            const double along = p.l.dot(normal);
+            const double part = p.R * f.size_weight[j] * along * along;
+            if (along > 0.0) {
+                positive += part;
+            } else {
+                negative += part;
+            }
+        }
+        sums.moment_matrix = surface_corrected_moment_matrix<D>(sums.moment_matrix, normal, positive, negative);
+    } else {
+        OneSidedMoments<D> sides;
+        for (NodeIndex j : row) accumulate_one_sided_moments(f.pairs.template pair<W>(i, j), f.size_weight[j], sides);
+        sums.moment = surface_corrected_moment(sums.moment, sides);
+    }
+}
+
 template <class G, class W, bool full>
 void gradient_impl(const CompressedRows& lists, const GradientFields<G::dim>& f, std::size_t n) {
     constexpr int D = G::dim;
@@ -109,6 +144,7 @@ void gradient_impl(const CompressedRows& lists, const GradientFields<G::dim>& f,
                 if (f.pairs.sliding(i, j)) dv = along_pair<D>(f.pairs.sliding_normal(i, j, p.l), dv);  // spec section 2
                 accumulate_gradient<D, full>(p, f.size_weight[j], dv, sums);
             }
+            if (f.surface_correction) correct_for_surface<G, W, full>(f, row, i, sums);
             Mat<D> normalisation;
             if constexpr (full) {
                 // Spec section 7: N = M^-1. Each eigenvalue of M is held at or above

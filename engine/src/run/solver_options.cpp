@@ -63,6 +63,10 @@ std::vector<SolverOption> make_table() {
                  choice_of(&S::normalisation, {{"per-direction", Normalisation::PerDirection},
                                                {"moment-matrix", Normalisation::MomentMatrix}}),
                  "geometry factors alpha_b (Eq. 14-15) or the inverse of the full moment matrix", ""});
+    t.push_back({"surface_correction", BooleanOption{&S::surface_correction},
+                 "halve the geometry factor normal to a free surface (the paper's section 2.5; per axis, or along the "
+                 "neighbourhood's normal with the moment matrix)",
+                 ""});
     t.push_back({"viscosity",
                  choice_of(&S::viscosity, {{"none", ViscosityKind::None},
                                            {"nodal", ViscosityKind::Nodal},

@@ -273,6 +273,7 @@ void Simulation::Impl::gradient() {
     f.pairs = contact.fields(f.pairs, nodes);
     f.alpha_limit = scene.solver.alpha_limit;
     f.full_normalisation = scene.solver.normalisation == Normalisation::MomentMatrix;
+    f.surface_correction = scene.solver.surface_correction;
     f.allow_degenerate = true;  // a fragment that has lost its neighbours flies on (see fields.hpp)
     const NeighbourLists::PairTerms kept = neighbour_lists.keep_pairs(real);  // for the sweeps after this one
     f.keep_weight = kept.weight;

@@ -128,6 +128,9 @@ struct GradientFields {
     // The paper's per-direction normalisation (false) or the full moment matrix (true, spec
     // section 7); with the full one, the off-diagonal entries of M^-1 go to alpha_shear.
     bool full_normalisation = false;
+    // The paper's correction at free surfaces and interfaces (section 2.5; kernels.hpp,
+    // OneSidedMoments): the normalisation halved normal to a one-sided neighbourhood.
+    bool surface_correction = false;
     // outputs, one value per centre
     std::array<double*, D> alpha{};                 // the diagonal of the normalisation N
     std::array<double*, 3> alpha_shear{};           // off-diagonal N: 2D xz; 3D yz, xz, xy (full only)

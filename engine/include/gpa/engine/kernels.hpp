@@ -60,6 +60,57 @@ inline void accumulate_gradient(const PairGeometry<D>& p, double size_weight_j, 
     sums.stiffness.noalias() += u * u.transpose();
 }
 
+// The correction of the paper's section 2.5 at free surfaces and interfaces (spec section 7): a
+// node whose neighbours lie on one side of it along some direction gets a geometry factor there
+// about twice the interior one (1.26 / 0.63 at a flat lattice face), and its own stress pushes
+// the nodes behind it twice as hard as an interior node's does; the paper halves that factor. gpa's
+// rule is continuous in the neighbours' positions, so that no node jumps between two regimes:
+//  * per-direction normalisation: along each axis b the moment S_b = sum_j R W l_b^2 becomes
+//    S_b + |S_b+ - S_b-| = 2 max(S_b+, S_b-), S_b+ (S_b-) the part of the neighbours with l_b > 0
+//    (< 0). An even neighbourhood keeps its alpha_b, a flat face normal to b gets half of it (the
+//    paper's correction), a corner half along both of its axes.
+//  * moment matrix: the same along the neighbourhood's own normal n, the direction of the first
+//    moment sum_j R W l (frame-invariant: it turns with the neighbourhood):
+//    M' = M + |S_n+ - S_n-| n n^T with S_n+- = sum over l.n >< 0 of R W (l.n)^2. On a face normal to
+//    an axis both rules give the paper's halving; at a corner this one corrects along the diagonal.
+// The forces read the same corrected factors as the strain rates, so the energy identity of spec
+// section 5 holds, and the pair forces stay equal and opposite (momentum). What it gives up: the
+// strain rate of an affine field normal to a face comes out halved there.
+template <int D>
+struct OneSidedMoments {
+    Vec<D> positive = Vec<D>::Zero();  // sum over l_b > 0 (or l.n > 0) of R W l_b^2
+    Vec<D> negative = Vec<D>::Zero();  // the same over l_b < 0
+};
+
+// One neighbour's share of the per-axis one-sided moments.
+template <int D>
+inline void accumulate_one_sided_moments(const PairGeometry<D>& p, double size_weight_j, OneSidedMoments<D>& m) {
+    const double rw = p.R * size_weight_j;
+    for (int b = 0; b < D; ++b) {
+        const double part = rw * p.l[b] * p.l[b];
+        if (p.l[b] > 0.0) {
+            m.positive[b] += part;
+        } else {
+            m.negative[b] += part;
+        }
+    }
+}
+
+// The per-axis rule above: the corrected moments S_b + |S_b+ - S_b-|.
+template <int D>
+inline Vec<D> surface_corrected_moment(const Vec<D>& moment, const OneSidedMoments<D>& sides) {
+    return moment + (sides.positive - sides.negative).cwiseAbs();
+}
+
+// The moment-matrix rule above, given the first moment sum_j R W l (`first_moment`) and the
+// one-sided moments along its direction (OneSidedMoments::positive[0] and negative[0], summed
+// with l.n in place of l_b). A first moment of exactly 0 (a symmetric neighbourhood) leaves M alone.
+template <int D>
+inline Mat<D> surface_corrected_moment_matrix(const Mat<D>& moment_matrix, const Vec<D>& normal, double positive,
+                                              double negative) {
+    return moment_matrix + std::abs(positive - negative) * normal * normal.transpose();
+}
+
 // The length that sets node i's stable time step (spec section 11, made to see degenerate
 // neighbourhoods): a velocity difference to a neighbour changes the node's strain rate by
 // N R W l / r (N the normalisation: diag(alpha), or M^-1), so its highest frequency is about

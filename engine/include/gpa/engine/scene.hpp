@@ -218,6 +218,9 @@ struct SolverOptions {
     NodeDiameter node_diameter = NodeDiameter::Stretch;
     WeightKind weight = WeightKind::Gpa;
     Normalisation normalisation = Normalisation::PerDirection;
+    // The paper's correction at free surfaces and interfaces (its section 2.5): the geometry factor
+    // normal to a one-sided neighbourhood halved (kernels.hpp, OneSidedMoments; docs/surfaces.md).
+    bool surface_correction = false;
     ViscosityKind viscosity = ViscosityKind::Nodal;
     double viscosity_linear = 0.2;     // C_L (Eq. 36, 37)
     double viscosity_quadratic = 4.0;  // C_Q

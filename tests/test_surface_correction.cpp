@@ -1,0 +1,163 @@
+// The paper's correction at free surfaces and interfaces (its section 2.5, spec section 7;
+// kernels.hpp, OneSidedMoments): its lattice numbers, and the balances of a run with it.
+//
+// The paper's set-up (spec section 7): a plane-strain lattice of unit nodes (d = 1, A = 1, a = 1,
+// the GPA weight, variable connectivity) under a uniform sigma_z = -1. The net z-force between a
+// node and its neighbours on one side of it along z, its own stress on them less theirs on it, is
+// 1 (the stress times the unit area) for an interior node A. At a node B in the middle of the free
+// top face, alpha_z is twice the interior value, its own stress pushes the row below twice as hard
+// and the net force is 1.5; at the top corner D alpha_z is 2.45 times the interior value and the
+// net force 1.48; at a node C of a side face it is 0.98 (the interior node above it pushes it with
+// its smaller alpha). Halving alpha_z at B and D gives 1.0 and 0.98: the correction makes the top
+// face's nodes carry what the side face's already do.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include <Eigen/LU>
+#include "gpa/engine/drivers.hpp"
+#include "gpa/engine/neighbours.hpp"
+#include "gpa/engine/simulation.hpp"
+#include "support/lattices.hpp"
+
+namespace gpa {
+namespace {
+
+struct StressedBlock {
+    NodeStore nodes = testing::make_lattice(unit_cells());
+    CompressedRows lists;
+    bool full = false;
+
+    static testing::LatticeOptions unit_cells() {
+        testing::LatticeOptions o;  // 7 x 7 unit cells, nodes at 0.5 ... 6.5
+        o.cells = 7;
+        o.spacing = 1.0;
+        return o;
+    }
+
+    StressedBlock(bool corrected, bool moment_matrix) : full(moment_matrix) {
+        lists = find_neighbours(nodes, 1.0, nodes.size());
+        for (std::size_t i = 0; i < nodes.size(); ++i) {
+            // Uniform sigma_z = -1: s = (1/3, -2/3, 0, 1/3), P = 1/3.
+            nodes.deviatoric_stress[0][i] = 1.0 / 3.0;
+            nodes.deviatoric_stress[1][i] = -2.0 / 3.0;
+            nodes.deviatoric_stress[2][i] = 0.0;
+            nodes.deviatoric_stress[3][i] = 1.0 / 3.0;
+            nodes.pressure[i] = 1.0 / 3.0;
+        }
+        auto f = gradient_fields<2>(nodes, 1.0);
+        f.full_normalisation = moment_matrix;
+        f.surface_correction = corrected;
+        compute_velocity_gradient<PlaneStrain>(lists, WeightKind::Gpa, f);
+    }
+
+    std::size_t node_at(double x, double z) const {
+        for (std::size_t i = 0; i < nodes.size(); ++i) {
+            if (nodes.position[0][i] == x && nodes.position[1][i] == z) return i;
+        }
+        ADD_FAILURE() << "no node at " << x << ", " << z;
+        return 0;
+    }
+
+    Mat<2> normalisation(std::size_t i) const {
+        std::array<const double*, 2> alpha{nodes.alpha[0].data(), nodes.alpha[1].data()};
+        std::array<const double*, 3> shear{full ? nodes.alpha_shear[0].data() : nullptr, nullptr, nullptr};
+        return normalisation_of<2>(alpha, shear, i);
+    }
+
+    // The z-force that centre i's stress exerts on j (Eq. 22).
+    double force_z(std::size_t i, std::size_t j) const {
+        const auto f = force_fields<2>(const_cast<NodeStore&>(nodes), 1.0);
+        const auto p = f.pairs.pair<GpaWeight>(i, j);
+        const auto sigma = cauchy_stress<PlaneStrain>(f.deviatoric_stress, f.pressure, nullptr, i);
+        return pair_force(p, nodes.volume[i], nodes.size_weight[j], (normalisation(i) * p.l).eval(), sigma, 0.0)[1];
+    }
+
+    // |sum over the neighbours at z + dz of (i's force on them - theirs on i)|, z-components.
+    double net_force(double x, double z, double dz) const {
+        const std::size_t i = node_at(x, z);
+        double net = 0.0;
+        int counted = 0;
+        for (double dx : {-1.0, 0.0, 1.0}) {
+            const double xj = x + dx, zj = z + dz;
+            if (xj < 0.0 || xj > 7.0 || zj < 0.0 || zj > 7.0) continue;
+            const std::size_t j = node_at(xj, zj);
+            net += force_z(i, j) - force_z(j, i);
+            ++counted;
+        }
+        EXPECT_GE(counted, 2);
+        return std::abs(net);
+    }
+};
+
+// The lattice's nodes: A interior, B the middle of the free top face, C a side face, D the top
+// corner (x = 6.5 is the block's right face, z = 6.5 its top).
+constexpr double top = 6.5, side = 6.5, middle = 3.5;
+
+TEST(SurfaceCorrection, ThePapersLatticeNodesWithoutIt) {
+    const StressedBlock b(false, false);
+    // Interior: 1 exactly (the paper's 1.0000); top face 1.5; side 1 - 0.0923 + 0.0707 / ... = 0.979; corner 1.479.
+    EXPECT_NEAR(b.net_force(middle, middle, +1.0), 1.0, 1e-12);
+    EXPECT_NEAR(b.net_force(middle, top, -1.0), 1.5, 1e-12);
+    EXPECT_NEAR(b.net_force(side, middle, +1.0), 0.98, 5e-3);  // the paper's two decimals
+    EXPECT_NEAR(b.net_force(side, top, -1.0), 1.48, 5e-3);
+}
+
+TEST(SurfaceCorrection, HalvesAlphaNormalToTheFaceAndGivesThePapersCorrectedForces) {
+    const StressedBlock plain(false, false), corrected(true, false);
+    const std::size_t interior = plain.node_at(middle, middle), face = plain.node_at(middle, top),
+                      corner = plain.node_at(side, top), side_node = plain.node_at(side, middle);
+    // alpha normal to a face halved, alpha along it kept; interior nodes keep both (exactly: an even
+    // neighbourhood's two sides cancel).
+    EXPECT_EQ(corrected.nodes.alpha[0][interior], plain.nodes.alpha[0][interior]);
+    EXPECT_EQ(corrected.nodes.alpha[1][interior], plain.nodes.alpha[1][interior]);
+    EXPECT_NEAR(corrected.nodes.alpha[1][face], 0.5 * plain.nodes.alpha[1][face], 1e-15);
+    EXPECT_EQ(corrected.nodes.alpha[0][face], plain.nodes.alpha[0][face]);
+    EXPECT_NEAR(corrected.nodes.alpha[0][side_node], 0.5 * plain.nodes.alpha[0][side_node], 1e-15);
+    EXPECT_EQ(corrected.nodes.alpha[1][side_node], plain.nodes.alpha[1][side_node]);
+    EXPECT_NEAR(corrected.nodes.alpha[0][corner], 0.5 * plain.nodes.alpha[0][corner], 1e-15);
+    EXPECT_NEAR(corrected.nodes.alpha[1][corner], 0.5 * plain.nodes.alpha[1][corner], 1e-15);
+    // The face's alpha_z back at the interior value: 1.26 -> 0.63.
+    EXPECT_NEAR(corrected.nodes.alpha[1][face], plain.nodes.alpha[1][interior], 1e-12);
+
+    EXPECT_NEAR(corrected.net_force(middle, middle, +1.0), 1.0, 1e-12);
+    EXPECT_NEAR(corrected.net_force(middle, top, -1.0), 1.0, 1e-12);  // paper: B 1.5 -> 1.0
+    EXPECT_NEAR(corrected.net_force(side, top, -1.0), 0.98, 5e-3);    // paper: D 1.48 -> 0.98
+    // The side node's z-force is its own alpha_z's, which the correction leaves: 0.98 both ways.
+    EXPECT_EQ(corrected.net_force(side, middle, +1.0), plain.net_force(side, middle, +1.0));
+}
+
+TEST(SurfaceCorrection, TheMomentMatrixRuleGivesThePapersNumbersOnAFaceAndCorrectsACornerAlongItsDiagonal) {
+    const StressedBlock plain(false, true), corrected(true, true);
+    // Uncorrected, the moment matrix gives the per-direction numbers on the face (its M is diagonal
+    // there) and, with the shear of the corner's M, the same net force at the corner.
+    EXPECT_NEAR(plain.net_force(middle, top, -1.0), 1.5, 1e-12);
+    EXPECT_NEAR(plain.net_force(side, top, -1.0), 1.48, 5e-3);
+    // A face's normal is an axis: the paper's halving.
+    EXPECT_NEAR(corrected.net_force(middle, middle, +1.0), 1.0, 1e-12);
+    EXPECT_NEAR(corrected.net_force(middle, top, -1.0), 1.0, 1e-12);
+    // At the corner the neighbourhood's normal is the diagonal n = -(1, 1) / sqrt 2 (its first
+    // moment: R W l of the left and lower nodes, R = 1/2, and of the diagonal one, R = 1 - sqrt 2 / 2).
+    // All three lie on the inner side of it, so M gains S_n+ n n^T with
+    // S_n+ = 2 (1/2)(1/2) + (1 - sqrt 2 / 2) = 1.5 - sqrt 2 / 2: each entry of M' - M is half that.
+    const std::size_t c = corrected.node_at(side, top);
+    const Mat<2> gained = corrected.normalisation(c).inverse() - plain.normalisation(c).inverse();
+    const double expected = 0.5 * (1.5 - std::sqrt(2.0) / 2.0);
+    EXPECT_NEAR(gained(0, 0), expected, 1e-12);
+    EXPECT_NEAR(gained(1, 1), expected, 1e-12);
+    EXPECT_NEAR(gained(0, 1), expected, 1e-12);
+    // Not twice each axis, as the per-axis rule: the net force at the corner falls from 1.48 to
+    // 1.23, not to 0.98.
+    const double corner = corrected.net_force(side, top, -1.0);
+    EXPECT_NEAR(corner, 1.229, 5e-4);
+    // The face node is corrected the same way by both rules.
+    const StressedBlock per_axis(true, false);
+    const std::size_t face = per_axis.node_at(middle, top);
+    EXPECT_NEAR(corrected.nodes.alpha[1][face], per_axis.nodes.alpha[1][face], 1e-14);
+    EXPECT_NEAR(corrected.nodes.alpha_shear[0][face], 0.0, 1e-14);
+}
+
+}  // namespace
+}  // namespace gpa
