@@ -92,6 +92,20 @@ struct StressedBlock {
     }
 };
 
+TEST(SurfaceCorrection, AMomentGainsNothingWhileNearEvenAndItselfWhenOneSideIsEmpty) {
+    // A side at least a third of the other (|p - n| <= (p + n) / 2): no gain.
+    EXPECT_EQ(one_sided_gain(1.0, 1.0, one_sided_threshold), 0.0);
+    EXPECT_EQ(one_sided_gain(3.0, 1.0, one_sided_threshold), 0.0);
+    EXPECT_EQ(one_sided_gain(1.0, 3.0, one_sided_threshold), 0.0);
+    // One side empty: the whole moment (the factor halved), whichever side.
+    EXPECT_DOUBLE_EQ(one_sided_gain(2.5, 0.0, one_sided_threshold), 2.5);
+    EXPECT_DOUBLE_EQ(one_sided_gain(0.0, 2.5, one_sided_threshold), 2.5);
+    // Linear in between and continuous at the threshold: p = 7, n = 1 is half-way from 3:1 to 1:0
+    // in |p - n| / (p + n) = 0.75, so half the moment.
+    EXPECT_DOUBLE_EQ(one_sided_gain(7.0, 1.0, one_sided_threshold), 4.0);
+    EXPECT_LT(one_sided_gain(3.0 + 1e-9, 1.0, one_sided_threshold), 1e-8);
+}
+
 // The lattice's nodes: A interior, B the middle of the free top face, C a side face, D the top
 // corner (x = 6.5 is the block's right face, z = 6.5 its top).
 constexpr double top = 6.5, side = 6.5, middle = 3.5;

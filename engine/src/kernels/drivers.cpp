@@ -112,11 +112,11 @@ void correct_for_surface(const GradientFields<G::dim>& f, std::span<const NodeIn
                 negative += part;
             }
         }
-        sums.moment_matrix = surface_corrected_moment_matrix<D>(sums.moment_matrix, normal, positive, negative);
+        sums.moment_matrix = surface_corrected_moment_matrix<D>(sums.moment_matrix, normal, positive, negative, one_sided_threshold);
     } else {
         OneSidedMoments<D> sides;
         for (NodeIndex j : row) accumulate_one_sided_moments(f.pairs.template pair<W>(i, j), f.size_weight[j], sides);
-        sums.moment = surface_corrected_moment(sums.moment, sides);
+        sums.moment = surface_corrected_moment(sums.moment, sides, one_sided_threshold);
     }
 }
 

@@ -60,22 +60,31 @@ inline void accumulate_gradient(const PairGeometry<D>& p, double size_weight_j, 
     sums.stiffness.noalias() += u * u.transpose();
 }
 
-// The correction of the paper's section 2.5 at free surfaces and interfaces (spec section 7): a
-// node whose neighbours lie on one side of it along some direction gets a geometry factor there
-// about twice the interior one (1.26 / 0.63 at a flat lattice face), and its own stress pushes
-// the nodes behind it twice as hard as an interior node's does; the paper halves that factor. gpa's
-// rule is continuous in the neighbours' positions, so that no node jumps between two regimes:
-//  * per-direction normalisation: along each axis b the moment S_b = sum_j R W l_b^2 becomes
-//    S_b + |S_b+ - S_b-| = 2 max(S_b+, S_b-), S_b+ (S_b-) the part of the neighbours with l_b > 0
-//    (< 0). An even neighbourhood keeps its alpha_b, a flat face normal to b gets half of it (the
-//    paper's correction), a corner half along both of its axes.
-//  * moment matrix: the same along the neighbourhood's own normal n, the direction of the first
-//    moment sum_j R W l (frame-invariant: it turns with the neighbourhood):
-//    M' = M + |S_n+ - S_n-| n n^T with S_n+- = sum over l.n >< 0 of R W (l.n)^2. On a face normal to
-//    an axis both rules give the paper's halving; at a corner this one corrects along the diagonal.
+// The correction of the paper's section 2.5 at free surfaces and interfaces (spec section 7;
+// docs/surfaces.md): a node whose neighbours lie on one side of it along some direction gets a
+// geometry factor there about twice the interior one (1.26 / 0.63 at a flat lattice face), and its
+// own stress pushes the nodes behind it twice as hard as an interior node's does; the paper halves
+// that factor. Along a direction, with p and n the parts of the moment from the neighbours on its
+// two sides, the moment gains one_sided_gain(p, n): nothing while the neighbourhood is near even,
+// the moment itself (the factor halved) when one side is empty, linear in between, so that no
+// node's factor jumps from one step to the next.
+//  * per-direction normalisation: along each axis b, S_b = sum_j R W l_b^2 with p (n) over the
+//    neighbours with l_b > 0 (< 0). A flat face normal to b gets half its alpha_b (the paper's
+//    correction), a corner half along both of its axes.
+//  * moment matrix: along the neighbourhood's own normal n, the direction of the first moment
+//    sum_j R W l (frame-invariant: it turns with the neighbourhood), M' = M + gain n n^T with p and
+//    n the parts of sum_j R W (l.n)^2 over l.n > 0 and < 0. On a face normal to an axis both rules
+//    give the paper's halving; at a corner this one corrects along the diagonal only.
 // The forces read the same corrected factors as the strain rates, so the energy identity of spec
 // section 5 holds, and the pair forces stay equal and opposite (momentum). What it gives up: the
 // strain rate of an affine field normal to a face comes out halved there.
+//
+// How even is "near even": one side at least a third of the other (|p - n| <= (p + n) / 2). With
+// no threshold (every uneven neighbourhood corrected in proportion), the interior nodes of an
+// impact, whose neighbourhoods the flow makes uneven, were softened too, and the Armco cylinder at
+// 20 nodes across took 2.8 times the steps (docs/surfaces.md).
+constexpr double one_sided_threshold = 0.5;
+
 template <int D>
 struct OneSidedMoments {
     Vec<D> positive = Vec<D>::Zero();  // sum over l_b > 0 (or l.n > 0) of R W l_b^2
@@ -96,19 +105,28 @@ inline void accumulate_one_sided_moments(const PairGeometry<D>& p, double size_w
     }
 }
 
-// The per-axis rule above: the corrected moments S_b + |S_b+ - S_b-|.
-template <int D>
-inline Vec<D> surface_corrected_moment(const Vec<D>& moment, const OneSidedMoments<D>& sides) {
-    return moment + (sides.positive - sides.negative).cwiseAbs();
+// What a direction's moment gains from its two one-sided parts p and n (rules above): nothing
+// while |p - n| <= t (p + n), and from there linearly up to p + n, the moment doubled, when one
+// side is empty: max(0, |p - n| - t (p + n)) / (1 - t), t = one_sided_threshold.
+inline double one_sided_gain(double positive, double negative, double threshold) {
+    const double excess = std::abs(positive - negative) - threshold * (positive + negative);
+    return excess > 0.0 ? excess / (1.0 - threshold) : 0.0;
 }
 
-// The moment-matrix rule above, given the first moment sum_j R W l (`first_moment`) and the
-// one-sided moments along its direction (OneSidedMoments::positive[0] and negative[0], summed
-// with l.n in place of l_b). A first moment of exactly 0 (a symmetric neighbourhood) leaves M alone.
+// The per-axis rule above: the corrected moments S_b + gain_b.
+template <int D>
+inline Vec<D> surface_corrected_moment(const Vec<D>& moment, const OneSidedMoments<D>& sides, double threshold) {
+    Vec<D> corrected = moment;
+    for (int b = 0; b < D; ++b) corrected[b] += one_sided_gain(sides.positive[b], sides.negative[b], threshold);
+    return corrected;
+}
+
+// The moment-matrix rule above, given the unit normal n (the direction of the first moment
+// sum_j R W l) and the one-sided parts of sum_j R W (l.n)^2 along it.
 template <int D>
 inline Mat<D> surface_corrected_moment_matrix(const Mat<D>& moment_matrix, const Vec<D>& normal, double positive,
-                                              double negative) {
-    return moment_matrix + std::abs(positive - negative) * normal * normal.transpose();
+                                              double negative, double threshold) {
+    return moment_matrix + one_sided_gain(positive, negative, threshold) * normal * normal.transpose();
 }
 
 // The length that sets node i's stable time step (spec section 11, made to see degenerate
