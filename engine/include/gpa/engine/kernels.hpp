@@ -87,8 +87,8 @@ constexpr double one_sided_threshold = 0.5;
 
 template <int D>
 struct OneSidedMoments {
-    Vec<D> positive = Vec<D>::Zero();  // sum over l_b > 0 (or l.n > 0) of R W l_b^2
-    Vec<D> negative = Vec<D>::Zero();  // the same over l_b < 0
+    Vec<D> positive = Vec<D>::Zero();  // sum over the neighbours with l_b > 0 of R W l_b^2
+    Vec<D> negative = Vec<D>::Zero();  // the same over the others (l_b = 0 adds nothing)
 };
 
 // One neighbour's share of the per-axis one-sided moments.
