@@ -112,7 +112,10 @@ constexpr double top = 6.5, side = 6.5, middle = 3.5;
 
 TEST(SurfaceCorrection, ThePapersLatticeNodesWithoutIt) {
     const StressedBlock b(false, false);
-    // Interior: 1 exactly (the paper's 1.0000); top face 1.5; side 1 - 0.0923 + 0.0707 / ... = 0.979; corner 1.479.
+    // Interior: 1 exactly (the paper's 1.0000). Top face: its own alpha_z twice the interior's, so
+    // 2 x 0.5 + 0.5 = 1.5. Side node (alpha_z = 1 / (1 + (1 - sqrt 2 / 2)) = 0.7735 with two
+    // diagonals instead of four): its own push 0.5, the side node above 0.3867 and the interior
+    // diagonal 0.0923, 0.979 in all. Corner (alpha_z 1.547): its own 1.0, the same 0.479 back.
     EXPECT_NEAR(b.net_force(middle, middle, +1.0), 1.0, 1e-12);
     EXPECT_NEAR(b.net_force(middle, top, -1.0), 1.5, 1e-12);
     EXPECT_NEAR(b.net_force(side, middle, +1.0), 0.98, 5e-3);  // the paper's two decimals
