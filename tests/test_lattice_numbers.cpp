@@ -17,25 +17,12 @@ struct UnitLattice {
 
     UnitLattice() {
         lists = find_neighbours(nodes, 1.0, nodes.size());
-        for (std::size_t i = 0; i < nodes.size(); ++i) {
-            // Uniform sigma_z = -1: s = (1/3, -2/3, 0, 1/3), P = 1/3.
-            nodes.deviatoric_stress[0][i] = 1.0 / 3.0;
-            nodes.deviatoric_stress[1][i] = -2.0 / 3.0;
-            nodes.deviatoric_stress[2][i] = 0.0;
-            nodes.deviatoric_stress[3][i] = 1.0 / 3.0;
-            nodes.pressure[i] = 1.0 / 3.0;
-            if (nodes.position[0][i] == 3.5 && nodes.position[1][i] == 3.5) centre = i;
-        }
+        testing::set_uniaxial_stress_z(nodes, -1.0);
+        centre = testing::node_at(nodes, 3.5, 3.5);
         compute_velocity_gradient<PlaneStrain>(lists, WeightKind::Gpa, gradient_fields<2>(nodes, 1.0));
     }
 
-    std::size_t node_at(double x, double z) const {
-        for (std::size_t i = 0; i < nodes.size(); ++i) {
-            if (nodes.position[0][i] == x && nodes.position[1][i] == z) return i;
-        }
-        ADD_FAILURE() << "no node at " << x << ", " << z;
-        return 0;
-    }
+    std::size_t node_at(double x, double z) const { return testing::node_at(nodes, x, z); }
 
     // The z-force that centre i's stress exerts on j (Eq. 22).
     double force_z(std::size_t i, std::size_t j) const {

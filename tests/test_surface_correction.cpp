@@ -39,27 +39,14 @@ struct StressedBlock {
 
     StressedBlock(bool corrected, bool moment_matrix) : full(moment_matrix) {
         lists = find_neighbours(nodes, 1.0, nodes.size());
-        for (std::size_t i = 0; i < nodes.size(); ++i) {
-            // Uniform sigma_z = -1: s = (1/3, -2/3, 0, 1/3), P = 1/3.
-            nodes.deviatoric_stress[0][i] = 1.0 / 3.0;
-            nodes.deviatoric_stress[1][i] = -2.0 / 3.0;
-            nodes.deviatoric_stress[2][i] = 0.0;
-            nodes.deviatoric_stress[3][i] = 1.0 / 3.0;
-            nodes.pressure[i] = 1.0 / 3.0;
-        }
+        testing::set_uniaxial_stress_z(nodes, -1.0);
         auto f = gradient_fields<2>(nodes, 1.0);
         f.full_normalisation = moment_matrix;
         f.surface_correction = corrected;
         compute_velocity_gradient<PlaneStrain>(lists, WeightKind::Gpa, f);
     }
 
-    std::size_t node_at(double x, double z) const {
-        for (std::size_t i = 0; i < nodes.size(); ++i) {
-            if (nodes.position[0][i] == x && nodes.position[1][i] == z) return i;
-        }
-        ADD_FAILURE() << "no node at " << x << ", " << z;
-        return 0;
-    }
+    std::size_t node_at(double x, double z) const { return testing::node_at(nodes, x, z); }
 
     Mat<2> normalisation(std::size_t i) const {
         std::array<const double*, 2> alpha{nodes.alpha[0].data(), nodes.alpha[1].data()};

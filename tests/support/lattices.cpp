@@ -1,6 +1,8 @@
 #include "support/lattices.hpp"
 
 #include <algorithm>
+#include <stdexcept>
+#include <string>
 
 namespace gpa::testing {
 
@@ -57,6 +59,23 @@ double distance_to_boundary(const NodeStore& nodes, const LatticeOptions& o, std
         d = std::min({d, nodes.position[c][i] - lo_c, hi_c - nodes.position[c][i]});
     }
     return d;  // with x_origin = 0 the lower x edge is the axis
+}
+
+void set_uniaxial_stress_z(NodeStore& nodes, double sigma_z) {
+    for (std::size_t i = 0; i < nodes.size(); ++i) {
+        nodes.deviatoric_stress[0][i] = -sigma_z / 3.0;
+        nodes.deviatoric_stress[1][i] = 2.0 * sigma_z / 3.0;
+        nodes.deviatoric_stress[2][i] = 0.0;
+        nodes.deviatoric_stress[3][i] = -sigma_z / 3.0;
+        nodes.pressure[i] = -sigma_z / 3.0;
+    }
+}
+
+std::size_t node_at(const NodeStore& nodes, double x, double z) {
+    for (std::size_t i = 0; i < nodes.size(); ++i) {
+        if (nodes.position[0][i] == x && nodes.position[1][i] == z) return i;
+    }
+    throw std::out_of_range("node_at: no node at " + std::to_string(x) + ", " + std::to_string(z));
 }
 
 }  // namespace gpa::testing

@@ -35,6 +35,13 @@ void vary_diameters(NodeStore& nodes, double spread, std::uint64_t seed);
 // speeds in ranges that make every term matter.
 void randomise_state(NodeStore& nodes, std::uint64_t seed);
 
+// A uniform uniaxial stress sigma_z along the second axis of a plane-strain store, every node
+// alike: s = (-1/3, 2/3, 0, -1/3) sigma_z and P = -sigma_z / 3 (the spec's lattice example, section 7).
+void set_uniaxial_stress_z(NodeStore& nodes, double sigma_z);
+
+// The index of the node at exactly (x, z) of a 2D store; std::out_of_range when there is none.
+std::size_t node_at(const NodeStore& nodes, double x, double z);
+
 // Distance from node i to the nearest edge of the lattice box (and to the axis in
 // axisymmetric geometry), for selecting complete neighbourhoods.
 double distance_to_boundary(const NodeStore& nodes, const LatticeOptions& o, std::size_t i);
