@@ -161,20 +161,36 @@ LatticeBlock body_lattice(const Scene& scene, std::size_t index) {
     // must lie on a face of the body's cells: the ghost of a node s/2 from the plane is then s/2
     // behind it, where the full body's lattice has its mirror node, and fixed lists continue across
     // it (fill_lattice).
+    // A turned body (or an oblique plane) is cut in the body's own axes, where the plane must lie
+    // along a lattice axis.
+    block.rotation = b.rotation;
+    block.pivot = b.origin;
     for (std::size_t k = 0; k < scene.planes.size(); ++k) {
         if (!symmetry_plane_cuts(scene, index, k)) continue;
-        const PlaneSpec& plane = scene.planes[k];
+        const PlaneSpec& given = scene.planes[k];
+        MirrorPlane own{given.axis, given.position, given.side, 0, given.normal};
+        const auto in_block = lattice_mirror_planes(block, {own}, dim);
+        if (in_block.empty()) {
+            const auto n = plane_normal(given);
+            throw InputError(fmt::format(
+                "plane \"{}\" (plane[{}]) with normal [{:.6g}, {:.6g}{}] cuts body \"{}\" obliquely to its lattice: a "
+                "symmetry plane through a body must lie along the body's lattice axes (turned with its rotation), so "
+                "that its ghosts continue the lattice",
+                given.name, k, n[0], n[1], dim == 3 ? fmt::format(", {:.6g}", n[2]) : std::string(), b.name));
+        }
+        const MirrorPlane& plane = in_block.front();
         const auto a = static_cast<std::size_t>(plane.axis);
         const double cells = (plane.position - block.origin[a]) / block.spacing[a];
         if (std::abs(cells - std::round(cells)) > 1e-6) {
             const double below = block.origin[a] + std::floor(cells) * block.spacing[a];
             const char letter = axis_letter(static_cast<int>(a), dim);
             throw InputError(fmt::format(
-                "plane \"{}\" (plane[{}]) at {} = {} m cuts body \"{}\" between two faces of its lattice's cells ({} = {} m "
+                "plane \"{}\" (plane[{}]) at {} = {} m{} cuts body \"{}\" between two faces of its lattice's cells ({} = {} m "
                 "and {} m): a symmetry plane through a body must lie on a cell face, so that its ghosts continue the "
                 "lattice; move the plane or the body's origin (a cylinder's or sphere's cell faces pass through its centre "
                 "in 3D; in 2D when it is an even number of cells across)",
-                plane.name, k, letter, plane.position, b.name, letter, below, below + block.spacing[a]));
+                given.name, k, letter, plane.position, is_identity(b.rotation) && given.axis >= 0 ? "" : " (in the body's own axes)",
+                b.name, letter, below, below + block.spacing[a]));
         }
         const double position = plane.position;
         const int side = plane.side;
@@ -223,7 +239,7 @@ std::size_t add_lattice_nodes(NodeStore& nodes, const Scene& scene, std::size_t 
     // a <= 1, and every lattice node within 2 a spacings beyond it (spec section 2: r < 2 h, h =
     // a d0), so that fixed and variable nodes see the same neighbours until the lattice deforms.
     if (b.lattice_neighbours == 0 && scene.solver.influence_distance > 1.0) block.stencil_reach = 2.0 * scene.solver.influence_distance;
-    block.mirror_planes = mirrors;
+    block.mirror_planes = lattice_mirror_planes(block, mirrors, dim);
     const std::size_t first = fill_lattice(nodes, block);
     if (nodes.size() == first) {
         throw InputError(fmt::format("body \"{}\": its lattice holds no node (spacing {} m too coarse for its size)", b.name, b.spacing));
@@ -248,7 +264,10 @@ std::size_t add_imported_nodes(NodeStore& nodes, const Scene& scene, std::size_t
     nodes.resize(first + set.size());
     for (std::size_t k = 0; k < set.size(); ++k) {
         const std::size_t i = first + k;
-        const auto& x = set.set().positions[k];
+        // The file's coordinates are offsets from the origin, turned by the body's rotation.
+        const auto& given = set.set().positions[k];
+        const std::array<double, 3> x = is_identity(b.rotation) ? std::array<double, 3>{given[0], given[1], dim == 3 ? given[2] : 0.0}
+                                                                : turn(b.rotation, {given[0], given[1], dim == 3 ? given[2] : 0.0});
         for (int c = 0; c < dim; ++c) {
             nodes.position[c][i] = x[c] + b.origin[c];
             nodes.initial_position[c][i] = nodes.position[c][i];

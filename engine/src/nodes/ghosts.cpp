@@ -28,18 +28,51 @@ void mirror_stress(int dim, int axis, std::array<double, 6>& s) {
     }
 }
 
+void GhostPlane::reflect_tensor(int dim, std::array<double, 6>& s) const {
+    if (axis >= 0) {
+        mirror_stress(dim, axis, s);
+        return;
+    }
+    // H S H with H = I - 2 n n^T: S - 2 n (S n)^T - 2 (S n) n^T + 4 (n . S n) n n^T.
+    const auto& n = normal;
+    if (dim == 2) {
+        const double sn0 = s[0] * n[0] + s[2] * n[1], sn1 = s[2] * n[0] + s[1] * n[1];
+        const double nsn = n[0] * sn0 + n[1] * sn1;
+        const auto entry = [&](double sij, int i, int j, double sni, double snj) {
+            return sij - 2.0 * (n[i] * snj + sni * n[j]) + 4.0 * nsn * n[i] * n[j];
+        };
+        const double xx = entry(s[0], 0, 0, sn0, sn0), zz = entry(s[1], 1, 1, sn1, sn1), xz = entry(s[2], 0, 1, sn0, sn1);
+        s[0] = xx, s[1] = zz, s[2] = xz;  // the out-of-plane component is unchanged
+        return;
+    }
+    // 3D order xx, yy, zz, yz, xz, xy
+    const double m[3][3] = {{s[0], s[5], s[4]}, {s[5], s[1], s[3]}, {s[4], s[3], s[2]}};
+    double sn[3];
+    for (int i = 0; i < 3; ++i) sn[i] = m[i][0] * n[0] + m[i][1] * n[1] + m[i][2] * n[2];
+    const double nsn = n[0] * sn[0] + n[1] * sn[1] + n[2] * sn[2];
+    const auto entry = [&](int i, int j) { return m[i][j] - 2.0 * (n[i] * sn[j] + sn[i] * n[j]) + 4.0 * nsn * n[i] * n[j]; };
+    s = {entry(0, 0), entry(1, 1), entry(2, 2), entry(1, 2), entry(0, 2), entry(0, 1)};
+}
+
+bool perpendicular(const GhostPlane& a, const GhostPlane& b) {
+    if (a.axis >= 0 && b.axis >= 0) return a.axis != b.axis;
+    const auto n = a.unit_normal(), m = b.unit_normal();
+    return std::abs(n[0] * m[0] + n[1] * m[1] + n[2] * m[2]) < 1e-9;
+}
+
 GhostSet::GhostSet(std::vector<GhostPlane> planes) : planes_(std::move(planes)) {
     if (planes_.size() > 8) throw InputError(fmt::format("at most 8 planes with ghosts, got {}", planes_.size()));
-    // Every non-empty combination of planes with distinct normals (corners and edges).
+    // Every non-empty combination of planes with mutually perpendicular normals (corners and
+    // edges): their reflections commute, and a corner ghost is the image across all of them. Planes
+    // meeting at another angle (or parallel) are not combined; near such a corner each acts alone.
     for (unsigned m = 1; m < (1u << planes_.size()); ++m) {
-        int axes = 0;
-        bool distinct = true;
+        bool combines = true;
         for (std::size_t p = 0; p < planes_.size(); ++p) {
-            if (!((m >> p) & 1u)) continue;
-            if (axes & (1 << planes_[p].axis)) distinct = false;
-            axes |= 1 << planes_[p].axis;
+            for (std::size_t q = p + 1; q < planes_.size(); ++q) {
+                if (((m >> p) & 1u) && ((m >> q) & 1u) && !perpendicular(planes_[p], planes_[q])) combines = false;
+            }
         }
-        if (distinct) masks_.push_back(static_cast<std::uint8_t>(m));
+        if (combines) masks_.push_back(static_cast<std::uint8_t>(m));
     }
     std::stable_sort(masks_.begin(), masks_.end(), [](std::uint8_t a, std::uint8_t b) { return std::popcount(a) < std::popcount(b); });
     index_.resize(masks_.size());
@@ -56,16 +89,27 @@ void GhostSet::update_contacts(NodeStore& nodes, std::size_t real_count, bool in
             for (std::size_t p = 0; p < planes_.size(); ++p) {
                 if (!planes_[p].lift_off) continue;
                 const auto bit = static_cast<std::uint8_t>(1u << p);
-                const int a = planes_[p].axis;
-                const double gap = planes_[p].distance(nodes.position[a][i]);
+                const GhostPlane& plane = planes_[p];
+                const double gap = plane.distance_of(nodes.position, i);
                 const bool close = gap < 0.75 * nodes.diameter[i];
                 if (initial) {
                     bits = close ? (bits | bit) : (bits & ~bit);
                 } else if (bits & bit) {
                     // sigma_nn = s_nn - P - Q: tension (> 0) releases the node.
-                    const double normal_stress = nodes.deviatoric_stress[a][i] - nodes.pressure[i] - nodes.viscous_pressure[i];
+                    double s_nn = 0.0;
+                    if (plane.axis >= 0) {
+                        s_nn = nodes.deviatoric_stress[plane.axis][i];
+                    } else {
+                        std::array<double, 6> t{};
+                        for (int c = 0; c < stress_components(nodes.dim()); ++c) t[c] = nodes.deviatoric_stress[c][i];
+                        const auto& n = plane.normal;
+                        s_nn = nodes.dim() == 2 ? t[0] * n[0] * n[0] + t[1] * n[1] * n[1] + 2.0 * t[2] * n[0] * n[1]
+                                                : t[0] * n[0] * n[0] + t[1] * n[1] * n[1] + t[2] * n[2] * n[2] +
+                                                      2.0 * (t[3] * n[1] * n[2] + t[4] * n[0] * n[2] + t[5] * n[0] * n[1]);
+                    }
+                    const double normal_stress = s_nn - nodes.pressure[i] - nodes.viscous_pressure[i];
                     if (normal_stress > 0.0 || !close) bits &= static_cast<std::uint8_t>(~bit);
-                } else if (close && planes_[p].side * nodes.velocity[a][i] < 0.0) {
+                } else if (close && plane.side * plane.coordinate_of(nodes.velocity, i) < 0.0) {
                     bits |= bit;
                 }
             }
@@ -96,7 +140,7 @@ void GhostSet::remove_pairs_without_contact(CompressedRows& lists, const NodeSto
 std::vector<MirrorPlane> GhostSet::mirror_planes() const {
     std::vector<MirrorPlane> out;
     for (std::size_t p = 0; p < planes_.size(); ++p) {
-        out.push_back({planes_[p].axis, planes_[p].position, planes_[p].side, static_cast<int>(p)});
+        out.push_back({planes_[p].axis, planes_[p].position, planes_[p].side, static_cast<int>(p), planes_[p].normal});
     }
     return out;
 }
@@ -128,7 +172,7 @@ void GhostSet::build(NodeStore& nodes, std::size_t real_count, GhostReach reach,
                 bool near = selectable(nodes, i, m);
                 const double range = reach.of(nodes.diameter[i]);
                 for (std::size_t p = 0; p < planes_.size() && near; ++p) {
-                    if ((m >> p) & 1u) near = planes_[p].distance(nodes.position[planes_[p].axis][i]) < range;
+                    if ((m >> p) & 1u) near = planes_[p].distance_of(nodes.position, i) < range;
                 }
                 want[i] = near;
             }
@@ -175,17 +219,22 @@ void GhostSet::update(NodeStore& nodes, std::size_t real_count) const {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, ghosts, 2048), [&](const tbb::blocked_range<std::size_t>& r) {
         for (std::size_t k = r.begin(); k != r.end(); ++k) {
             const std::size_t g = real_count + k, s = source_[k];
+            std::array<double, 3> x{0, 0, 0}, v{0, 0, 0}, x0{0, 0, 0};
             for (int c = 0; c < dim; ++c) {
-                nodes.position[c][g] = nodes.position[c][s];
-                nodes.velocity[c][g] = nodes.velocity[c][s];
-                nodes.initial_position[c][g] = nodes.initial_position[c][s];
+                x[c] = nodes.position[c][s];
+                v[c] = nodes.velocity[c][s];
+                x0[c] = nodes.initial_position[c][s];
             }
             for (std::size_t p = 0; p < planes_.size(); ++p) {
                 if (!((mask_[k] >> p) & 1u)) continue;
-                const int a = planes_[p].axis;
-                nodes.position[a][g] = 2.0 * planes_[p].position - nodes.position[a][g];
-                nodes.velocity[a][g] = -nodes.velocity[a][g];
-                nodes.initial_position[a][g] = 2.0 * planes_[p].position - nodes.initial_position[a][g];
+                planes_[p].reflect_point(x);
+                planes_[p].reflect_vector(v);
+                planes_[p].reflect_point(x0);
+            }
+            for (int c = 0; c < dim; ++c) {
+                nodes.position[c][g] = x[c];
+                nodes.velocity[c][g] = v[c];
+                nodes.initial_position[c][g] = x0[c];
             }
             nodes.mass[g] = nodes.mass[s];
             nodes.volume[g] = nodes.volume[s];
@@ -206,10 +255,12 @@ void GhostSet::mirror_vector_field(const std::array<double*, 3>& field, int dim,
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, source_.size(), 2048), [&](const tbb::blocked_range<std::size_t>& r) {
         for (std::size_t k = r.begin(); k != r.end(); ++k) {
             const std::size_t g = real_count + k, s = source_[k];
-            for (int c = 0; c < dim; ++c) field[c][g] = field[c][s];
+            std::array<double, 3> v{0, 0, 0};
+            for (int c = 0; c < dim; ++c) v[c] = field[c][s];
             for (std::size_t p = 0; p < planes_.size(); ++p) {
-                if ((mask_[k] >> p) & 1u) field[planes_[p].axis][g] = -field[planes_[p].axis][g];
+                if ((mask_[k] >> p) & 1u) planes_[p].reflect_vector(v);
             }
+            for (int c = 0; c < dim; ++c) field[c][g] = v[c];
         }
     });
 }
@@ -220,7 +271,7 @@ GhostReach GhostSet::pair_reach(const NodeStore& nodes, std::size_t real_count, 
         tbb::blocked_range<std::size_t>(0, real_count, 4096), -std::numeric_limits<double>::infinity(),
         [&](const tbb::blocked_range<std::size_t>& r, double acc) {
             for (std::size_t i = r.begin(); i != r.end(); ++i) {
-                for (const GhostPlane& p : planes_) acc = std::max(acc, a * nodes.diameter[i] - p.distance(nodes.position[p.axis][i]));
+                for (const GhostPlane& p : planes_) acc = std::max(acc, a * nodes.diameter[i] - p.distance_of(nodes.position, i));
             }
             return acc;
         },
@@ -244,7 +295,7 @@ bool GhostSet::covers(const NodeStore& nodes, std::size_t real_count, GhostReach
                     bool near = true;
                     const double range = reach.of(nodes.diameter[i]);
                     for (std::size_t p = 0; p < planes_.size() && near; ++p) {
-                        if ((m >> p) & 1u) near = planes_[p].distance(nodes.position[planes_[p].axis][i]) < range;
+                        if ((m >> p) & 1u) near = planes_[p].distance_of(nodes.position, i) < range;
                     }
                     found = near;
                 }
@@ -276,8 +327,15 @@ double GhostSet::mirrored_displacement_bound(const NodeStore& nodes, std::size_t
         if (!any) continue;
         std::array<double, 3> middle{0, 0, 0};
         for (int c = 0; c < dim; ++c) middle[c] = 0.5 * (lo[c] + hi[c]);
-        for (std::size_t p = 0; p < planes_.size(); ++p) {
-            if ((m >> p) & 1u) middle[planes_[p].axis] = 0.0;
+        for (std::size_t p = 0; p < planes_.size(); ++p) {  // the parts along the (perpendicular) normals removed
+            if (!((m >> p) & 1u)) continue;
+            if (planes_[p].axis >= 0) {
+                middle[planes_[p].axis] = 0.0;
+                continue;
+            }
+            const auto& n = planes_[p].normal;
+            const double along = n[0] * middle[0] + n[1] * middle[1] + n[2] * middle[2];
+            for (int c = 0; c < 3; ++c) middle[c] -= along * n[c];
         }
         double largest = 0.0;
         for (std::size_t k = 0; k < source_.size(); ++k) {
@@ -303,7 +361,7 @@ void GhostSet::refresh(NodeStore& nodes, std::size_t real_count) const {
             // Symmetric tensors in NodeStore order mirror across every plane of the ghost's mask.
             const auto mirrored = [&](std::array<double, 6> t) {
                 for (std::size_t p = 0; p < planes_.size(); ++p) {
-                    if ((mask_[k] >> p) & 1u) mirror_stress(dim, planes_[p].axis, t);
+                    if ((mask_[k] >> p) & 1u) planes_[p].reflect_tensor(dim, t);
                 }
                 return t;
             };
@@ -311,13 +369,17 @@ void GhostSet::refresh(NodeStore& nodes, std::size_t real_count) const {
             for (int c = 0; c < comps; ++c) stress[c] = nodes.deviatoric_stress[c][s];
             stress = mirrored(stress);
             for (int c = 0; c < comps; ++c) nodes.deviatoric_stress[c][g] = stress[c];
-            // The normalisation is symmetric too: its diagonal (alpha) is unchanged by a mirror,
-            // its off-diagonal entries (alpha_shear) flip like the shear stresses.
-            for (int c = 0; c < dim; ++c) nodes.alpha[c][g] = nodes.alpha[c][s];
+            // The normalisation is a symmetric tensor too. Across an aligned plane its diagonal
+            // (alpha) is unchanged and its off-diagonal entries (alpha_shear) flip like the shear
+            // stresses. Across an oblique one it is H A H; the per-direction normalisation, which
+            // keeps the diagonal only (its alpha_shear is zero), takes the diagonal of H A H: the
+            // frame-dependence of that normalisation (docs/orientation.md).
             const int first_shear = dim == 2 ? 2 : 3, shears = dim == 2 ? 1 : 3;
             std::array<double, 6> normalisation{};
+            for (int c = 0; c < dim; ++c) normalisation[c] = nodes.alpha[c][s];
             for (int c = 0; c < shears; ++c) normalisation[first_shear + c] = nodes.alpha_shear[c][s];
             normalisation = mirrored(normalisation);
+            for (int c = 0; c < dim; ++c) nodes.alpha[c][g] = normalisation[c];
             for (int c = 0; c < shears; ++c) nodes.alpha_shear[c][g] = normalisation[first_shear + c];
             nodes.pressure[g] = nodes.pressure[s];
             nodes.viscous_pressure[g] = nodes.viscous_pressure[s];
@@ -413,12 +475,13 @@ void GhostSet::fold_forces(NodeStore& nodes, std::size_t real_count) const {
     for (std::size_t k = 0; k < source_.size(); ++k) {
         if (continues_.size() != source_.size() || !continues_[k]) continue;
         const std::size_t g = real_count + k, s = source_[k];
+        std::array<double, 3> change{0, 0, 0};
+        for (int c = 0; c < dim; ++c) change[c] = nodes.force[c][g] - saved_force_[c][k];
+        for (std::size_t p = 0; p < planes_.size(); ++p) {
+            if ((mask_[k] >> p) & 1u) planes_[p].reflect_vector(change);
+        }
         for (int c = 0; c < dim; ++c) {
-            double change = nodes.force[c][g] - saved_force_[c][k];
-            for (std::size_t p = 0; p < planes_.size(); ++p) {
-                if (((mask_[k] >> p) & 1u) && planes_[p].axis == c) change = -change;
-            }
-            nodes.force[c][s] += change;
+            nodes.force[c][s] += change[c];
             nodes.force[c][g] = saved_force_[c][k];
         }
     }
@@ -429,7 +492,7 @@ std::vector<double> GhostSet::normal_reactions(const NodeStore& nodes, std::size
     for (std::size_t k = 0; k < source_.size(); ++k) {
         for (std::size_t p = 0; p < planes_.size(); ++p) {
             if ((mask_[k] >> p) & 1u) {
-                reaction[p] -= planes_[p].side * nodes.force[planes_[p].axis][real_count + k];
+                reaction[p] -= planes_[p].side * planes_[p].coordinate_of(nodes.force, real_count + k);
             }
         }
     }

@@ -60,6 +60,36 @@ struct CellHash {
 
 }  // namespace
 
+std::vector<MirrorPlane> lattice_mirror_planes(const LatticeBlock& block, const std::vector<MirrorPlane>& planes, int dim) {
+    std::vector<MirrorPlane> out;
+    const bool turned = !is_identity(block.rotation);
+    for (const MirrorPlane& p : planes) {
+        if (!turned && p.axis >= 0) {
+            out.push_back(p);
+            continue;
+        }
+        std::array<double, 3> n{0, 0, 0};
+        if (p.axis >= 0) n[static_cast<std::size_t>(p.axis)] = 1.0; else n = p.normal;
+        // n . x = c with x = pivot + R (x_b - pivot): n_b . (x_b - pivot) = c - n . pivot, n_b = R^T n.
+        const auto nb = turn_back(block.rotation, n);
+        int axis = -1;
+        for (int c = 0; c < dim; ++c) {
+            if (std::abs(std::abs(nb[c]) - 1.0) < 1e-9) axis = c;
+        }
+        if (axis < 0) continue;
+        const int sign = nb[axis] > 0.0 ? +1 : -1;
+        double offset = p.position;
+        for (int c = 0; c < dim; ++c) offset -= n[c] * block.pivot[c];
+        MirrorPlane local = p;
+        local.axis = axis;
+        local.position = block.pivot[axis] + sign * offset;
+        local.side = p.side * sign;
+        local.normal = {0, 0, 0};
+        out.push_back(local);
+    }
+    return out;
+}
+
 std::size_t fill_lattice(NodeStore& nodes, const LatticeBlock& block) {
     const int dim = nodes.dim();
     check_lattice_stencil(dim, block.lattice_neighbours);
@@ -112,7 +142,7 @@ std::size_t fill_lattice(NodeStore& nodes, const LatticeBlock& block) {
     index_of.reserve(added);
     for (std::size_t k = 0; k < added; ++k) {
         const std::size_t i = first_new + k;
-        const auto& p = centres[k];
+        const auto p = block.place(centres[k]);
         for (int c = 0; c < dim; ++c) {
             nodes.position[c][i] = p[c];
             nodes.initial_position[c][i] = p[c];

@@ -80,8 +80,8 @@ bool shape_known(const BodySpec& b) {
     return true;
 }
 
-// The interval a body occupies along an axis (before any node is placed).
-std::pair<double, double> extent(const BodySpec& b, GeometryKind g, int axis) {
+// The interval an unrotated body occupies along an axis (before any node is placed).
+std::pair<double, double> axis_extent(const BodySpec& b, GeometryKind g, int axis) {
     const int dim = dimension_of(g);
     const bool axial = axis == dim - 1;  // z
     const double o = b.origin[static_cast<std::size_t>(axis)];
@@ -108,11 +108,77 @@ std::pair<double, double> extent(const BodySpec& b, GeometryKind g, int axis) {
     return {o, o};
 }
 
+// The point of the body's shape as described (unrotated) that its rotation takes to p: origin +
+// R^T (p - origin) (BodySpec::rotation); p itself for an unrotated body.
+std::array<double, 3> to_body_frame(const BodySpec& b, const std::array<double, 3>& p) {
+    if (is_identity(b.rotation)) return p;
+    const auto& o = b.origin;
+    const auto q = turn_back(b.rotation, {p[0] - o[0], p[1] - o[1], p[2] - o[2]});
+    return {o[0] + q[0], o[1] + q[1], o[2] + q[2]};
+}
+
+// The interval of n . x over body b (n a unit vector in scene components): exact for an unrotated
+// body along an axis (axis_extent); otherwise the support of the shape as described, along n turned
+// into the body's frame, n_b = R^T n, with n . x = n . o + n_b . (x_b - o): a cylinder's (its nose
+// within it) and a sphere's exactly, a box's, a surface's or imported nodes' from their box.
+std::pair<double, double> extent_along(const BodySpec& b, GeometryKind g, const std::array<double, 3>& n) {
+    const int dim = dimension_of(g);
+    if (is_identity(b.rotation)) {
+        if (const auto a = aligned_axis(n, dim)) {
+            const auto [lo, hi] = axis_extent(b, g, a->axis);
+            return a->sign > 0 ? std::pair{lo, hi} : std::pair{-hi, -lo};
+        }
+    }
+    const auto nb = turn_back(b.rotation, n);
+    const auto& o = b.origin;
+    double at_origin = 0.0;
+    for (int c = 0; c < dim; ++c) at_origin += n[c] * o[c];
+    double lo = 0.0, hi = 0.0;  // of n_b . (x_b - o)
+    const auto add_interval = [&](double a, double z) {  // one term ranging over [min(a, z), max(a, z)]
+        lo += std::min(a, z);
+        hi += std::max(a, z);
+    };
+    switch (b.shape) {
+        case ShapeKind::Cylinder:
+        case ShapeKind::Plate: {
+            const double along = nb[dim - 1];
+            const double across = dim == 3 ? std::hypot(nb[0], nb[1]) : std::abs(nb[0]);
+            add_interval(0.0, b.length * along);
+            add_interval(-b.radius * across, b.radius * across);
+            break;
+        }
+        case ShapeKind::Sphere: add_interval(-b.radius, b.radius); break;
+        case ShapeKind::Rectangle:
+        case ShapeKind::Box:
+            for (int c = 0; c < dim; ++c) add_interval(0.0, nb[c] * b.size[c]);
+            break;
+        case ShapeKind::Surface:
+        case ShapeKind::Nodes: {
+            std::array<double, 3> lower{}, upper{};
+            if (b.shape == ShapeKind::Surface && b.surface) lower = b.surface->lower(), upper = b.surface->upper();
+            if (b.shape == ShapeKind::Nodes && b.node_set) lower = b.node_set->lower(), upper = b.node_set->upper();
+            // The shape's coordinates are offsets from the origin: x_b - o lies in [lower, upper].
+            for (int c = 0; c < dim; ++c) add_interval(nb[c] * lower[c], nb[c] * upper[c]);
+            break;
+        }
+    }
+    return {at_origin + lo, at_origin + hi};
+}
+
+// The interval a body occupies along an axis (before any node is placed).
+std::pair<double, double> extent(const BodySpec& b, GeometryKind g, int axis) {
+    if (is_identity(b.rotation)) return axis_extent(b, g, axis);
+    std::array<double, 3> e{0, 0, 0};
+    e[static_cast<std::size_t>(axis)] = 1.0;
+    return extent_along(b, g, e);
+}
+
 // Whether point p (scene coordinates: (x, z) in 2D, (x, y, z) in 3D) lies strictly inside body b's
 // shape as written in the scene (the shape its lattice fills: a node belongs to a body when its cell
-// centre is inside, docs/scene-format.md).
-bool inside_shape(const BodySpec& b, GeometryKind g, const std::array<double, 3>& p) {
+// centre is inside, docs/scene-format.md), turned by its rotation.
+bool inside_shape(const BodySpec& b, GeometryKind g, const std::array<double, 3>& at) {
     const int dim = dimension_of(g);
+    const std::array<double, 3> p = to_body_frame(b, at);
     const double z = p[static_cast<std::size_t>(dim - 1)];
     const auto& o = b.origin;
     switch (b.shape) {
@@ -191,14 +257,18 @@ void check_overlap(const Scene& scene, std::size_t a, std::size_t b) {
         return;
     }
     const LatticeBlock block = body_lattice(scene, a);
-    // The cells of the first body's block whose centres fall in the overlap of the extents.
+    // The cells of the first body's block whose centres fall in the overlap of the extents (all of
+    // them for a turned body, whose cells are in its own axes).
+    const bool turned = !is_identity(block.rotation);
     std::array<std::int64_t, 3> first_cell{0, 0, 0}, last_cell{1, 1, 1};
     double cells = 1.0;
     for (int k = 0; k < dim; ++k) {
         const auto c = static_cast<std::size_t>(k);
         const double s = block.spacing[c];
-        first_cell[c] = std::max(block.first[c], static_cast<std::int64_t>(std::floor((lo[c] - block.origin[c]) / s - 0.5)));
-        last_cell[c] = std::min(block.last[c], static_cast<std::int64_t>(std::ceil((hi[c] - block.origin[c]) / s - 0.5)) + 1);
+        first_cell[c] = turned ? block.first[c]
+                               : std::max(block.first[c], static_cast<std::int64_t>(std::floor((lo[c] - block.origin[c]) / s - 0.5)));
+        last_cell[c] = turned ? block.last[c]
+                              : std::min(block.last[c], static_cast<std::int64_t>(std::ceil((hi[c] - block.origin[c]) / s - 0.5)) + 1);
         if (last_cell[c] <= first_cell[c]) return;
         cells *= static_cast<double>(last_cell[c] - first_cell[c]);
     }
@@ -212,6 +282,7 @@ void check_overlap(const Scene& scene, std::size_t a, std::size_t b) {
                     const auto c = static_cast<std::size_t>(k);
                     p[c] = block.origin[c] + (static_cast<double>(cell[c]) + 0.5) * block.spacing[c];
                 }
+                p = block.place(p);
                 if (!inside_shape(first, g, p) || !inside_shape(second, g, p)) continue;
                 if (overlapping++ == 0) example = p;
             }
@@ -249,6 +320,16 @@ void check_body(const Scene& scene, const BodySpec& b, std::size_t i) {
     if (b.shape == ShapeKind::Box && dim == 2) {
         fail(fmt::format("{}.shape: a box is a 3D shape; {} takes cylinder, plate, rectangle or sphere", label,
                          g == GeometryKind::Axisymmetric ? "an axisymmetric scene" : "a plane-strain scene"));
+    }
+
+    if (!is_identity(b.rotation)) {
+        if (g == GeometryKind::Axisymmetric) {
+            fail(fmt::format("{}.rotation: an axisymmetric scene's bodies turn about its axis and cannot be rotated", label));
+        }
+        if (b.discretisation == Discretisation::Elements) {
+            fail(fmt::format("{}.rotation: element bodies are meshed along the scene's axes and cannot be rotated", label));
+        }
+        if (auto problem = rotation_problem(b.rotation, dim)) fail(fmt::format("{}.rotation is not a rotation: {}", label, *problem));
     }
 
     bool known_material = false;
@@ -429,7 +510,25 @@ void check_plane(const Scene& scene, const PlaneSpec& p, std::size_t i) {
     const int dim = dimension_of(g);
     const std::string label = plane_label(p, i);
     if (p.kind != PlaneKind::Rigid && p.kind != PlaneKind::Symmetry) fail(fmt::format("{}.kind: unknown plane kind", label));
-    if (p.axis < 0 || p.axis >= dim) {
+    const bool oblique = p.axis == -1;
+    if (oblique) {
+        if (g == GeometryKind::Axisymmetric) {
+            fail(fmt::format("{}: an axisymmetric scene's planes are normal to x or z (a plane at another angle would be a "
+                             "cone around the axis)", label));
+        }
+        double q = 0.0;
+        for (int c = 0; c < dim; ++c) q += p.normal[c] * p.normal[c];
+        if (!finite(q) || std::abs(q - 1.0) > 1e-12) {
+            fail(fmt::format("{}.normal must be a finite unit vector (its length squared is {})", label, q));
+        }
+        for (std::size_t k = 0; k < scene.bodies.size(); ++k) {
+            if (scene.bodies[k].discretisation == Discretisation::Elements) {
+                fail(fmt::format("{}: its normal is not a coordinate axis, and {} is discretised by elements, whose contact "
+                                 "with planes is along the scene's axes",
+                                 label, body_label(scene.bodies[k], k)));
+            }
+        }
+    } else if (p.axis < 0 || p.axis >= dim) {
         fail(fmt::format("{}.axis = {} is not a direction of {} scene ({})", label, p.axis,
                          g == GeometryKind::Axisymmetric ? "an axisymmetric" : dim == 2 ? "a plane-strain" : "a 3D",
                          dim == 2 ? "0 = x, 1 = z" : "0 = x, 1 = y, 2 = z"));
@@ -456,7 +555,9 @@ void check_plane(const Scene& scene, const PlaneSpec& p, std::size_t i) {
             }
         }
     }
-    const char letter = axis_letter(p.axis, dim);
+    // The coordinate named in messages: the axis, or "n . x" for an oblique plane.
+    const std::string letter = oblique ? std::string("n . x") : std::string(1, axis_letter(p.axis, dim));
+    const auto n = plane_normal(p);
     if (g == GeometryKind::Axisymmetric && p.axis == 0 && p.position <= 0.0) {
         fail(fmt::format("{}: a plane normal to x must lie at x > 0 in an axisymmetric scene (the axis x = 0 is a "
                          "symmetry plane already); it is at x = {} m",
@@ -465,7 +566,7 @@ void check_plane(const Scene& scene, const PlaneSpec& p, std::size_t i) {
     for (std::size_t k = 0; k < scene.bodies.size(); ++k) {
         const BodySpec& b = scene.bodies[k];
         if (!shape_known(b)) continue;
-        const auto [lo, hi] = extent(b, g, p.axis);
+        const auto [lo, hi] = extent_along(b, g, n);
         const double tolerance = plane_tolerance(b, p.position);
         if (symmetry_plane_cuts(scene, k, i)) {
             if (b.shape == ShapeKind::Nodes) {
@@ -576,7 +677,8 @@ bool any_initial_node(const Scene& scene, std::size_t b, const std::array<double
     const LatticeBlock block = body_lattice(scene, b);
     const bool elements = scene.bodies[b].discretisation == Discretisation::Elements;
     std::array<std::int64_t, 3> from = block.first, to = block.last;
-    for (int c = 0; c < dim; ++c) {
+    const bool turned = !is_identity(block.rotation);  // its cells are in its own axes: visit them all
+    for (int c = 0; c < dim && !turned; ++c) {
         const double o = block.origin[c], s = block.spacing[c];
         const double first = double(block.first[c]) - 1.0, last = double(block.last[c]) + 1.0;
         if (std::isfinite(lo[c])) from[c] = std::max(from[c], std::int64_t(std::clamp(std::floor((lo[c] - o) / s) - 1.0, first, last)));
@@ -593,7 +695,7 @@ bool any_initial_node(const Scene& scene, std::size_t b, const std::array<double
                 std::array<double, 3> centre{0, 0, 0};
                 for (int c = 0; c < dim; ++c) centre[c] = block.origin[c] + (double(k[c]) + 0.5) * block.spacing[c];
                 if (block.inside && !block.inside(centre)) continue;
-                if (visit(centre)) return true;
+                if (visit(block.place(centre))) return true;
                 if (!elements) continue;
                 for (int corner = 0; corner < 4; ++corner) {  // element bodies are 2D
                     const std::array<double, 3> p{block.origin[0] + double(kx + (corner & 1)) * block.spacing[0],
@@ -739,6 +841,22 @@ void check_prescribed_velocity(const Scene& scene, std::size_t k) {
     }
     for (std::size_t p = 0; p < scene.planes.size(); ++p) {
         const PlaneSpec& plane = scene.planes[p];
+        if (plane.axis == -1) {  // an oblique plane: any prescribed motion with a part along its normal
+            const auto n = plane_normal(plane);
+            bool along = false;
+            for (int c = 0; c < dim; ++c) along = along || (moves_along(c) && n[c] != 0.0);
+            const bool touching = along && any_initial_node(scene, b, r.lower, r.upper, [&](const auto& q) {
+                double at = 0.0;
+                for (int c = 0; c < dim; ++c) at += n[c] * q[c];
+                return inside(r, q) && std::abs(at - plane.position) < 0.75 * d0;
+            });
+            if (touching) {
+                fail_here(fmt::format("{} moves nodes that touch {} with a part along its normal: they would be driven {} "
+                                      "it; hold the components along its normal at 0 there or keep the region off the plane",
+                                      label, plane_label(plane, p), plane.kind == PlaneKind::Rigid ? "into or off" : "off"));
+            }
+            continue;
+        }
         if (!moves_along(plane.axis) || !touches(plane.axis, plane.position)) continue;
         fail_here(fmt::format("{} moves nodes that touch {} along its normal (velocity.{} = {} m/s): they would be driven "
                               "{} it; hold {} at 0 there (a clamp on the plane) or keep the region off the plane",
@@ -889,10 +1007,10 @@ std::optional<SymmetrySpan> symmetry_span(const Scene& scene, std::size_t body, 
     const int dim = dimension_of(scene.geometry);
     if (body >= scene.bodies.size() || plane >= scene.planes.size()) return std::nullopt;
     const PlaneSpec& p = scene.planes[plane];
-    if (p.kind != PlaneKind::Symmetry || p.axis < 0 || p.axis >= dim || !finite(p.position)) return std::nullopt;
+    if (p.kind != PlaneKind::Symmetry || p.axis < -1 || p.axis >= dim || !finite(p.position)) return std::nullopt;
     const BodySpec& b = scene.bodies[body];
     if (!shape_known(b)) return std::nullopt;
-    const auto [lo, hi] = extent(b, scene.geometry, p.axis);
+    const auto [lo, hi] = extent_along(b, scene.geometry, plane_normal(p));
     return SymmetrySpan{lo, hi, p.position, plane_tolerance(b, p.position)};
 }
 
@@ -909,13 +1027,69 @@ bool reaches_symmetry_plane(const Scene& scene, std::size_t body, std::size_t pl
 }
 
 int symmetry_copies(const Scene& scene, std::size_t body) {
-    int copies = 1, axes = 0;
+    int copies = 1;
+    std::vector<std::array<double, 3>> normals;  // of the planes counted: parallel ones count once
     for (std::size_t k = 0; k < scene.planes.size(); ++k) {
-        if (!reaches_symmetry_plane(scene, body, k) || (axes & (1 << scene.planes[k].axis))) continue;
-        axes |= 1 << scene.planes[k].axis;
+        if (!reaches_symmetry_plane(scene, body, k)) continue;
+        const auto n = plane_normal(scene.planes[k]);
+        const bool parallel = std::any_of(normals.begin(), normals.end(), [&](const auto& m) {
+            return std::abs(std::abs(n[0] * m[0] + n[1] * m[1] + n[2] * m[2]) - 1.0) < 1e-9;
+        });
+        if (parallel) continue;
+        normals.push_back(n);
         copies *= 2;
     }
     return copies;
+}
+
+std::array<double, 3> plane_normal(const PlaneSpec& p) {
+    if (p.axis == -1) return p.normal;
+    std::array<double, 3> n{0, 0, 0};
+    if (p.axis >= 0 && p.axis < 3) n[static_cast<std::size_t>(p.axis)] = 1.0;
+    return n;
+}
+
+Scene rotated_scene(const Scene& scene, const Rotation& rotation) {
+    const int dim = dimension_of(scene.geometry);
+    if (scene.geometry == GeometryKind::Axisymmetric) {
+        throw InputError("rotation: an axisymmetric scene cannot be rotated (its axis is fixed)");
+    }
+    if (auto problem = rotation_problem(rotation, dim)) throw InputError(fmt::format("rotation is not a rotation: {}", *problem));
+    if (!scene.prescribed_velocities.empty()) {
+        throw InputError("rotation: the scene has prescribed-velocity regions, which are boxes in the scene's axes and do not "
+                         "turn; rotate its bodies and planes one by one instead");
+    }
+    Scene out = scene;
+    const auto turned = [&](const std::array<double, 3>& v) {
+        const auto w = gpa::turn(rotation, v);
+        return dim == 3 ? w : std::array<double, 3>{w[0], w[1], 0.0};
+    };
+    for (BodySpec& b : out.bodies) {
+        b.origin = turned(b.origin);
+        b.velocity = turned(b.velocity);
+        b.rotation = compose(rotation, b.rotation);
+        b.initial_stress = rotate_tensor(rotation, b.initial_stress, dim);
+    }
+    for (PlaneSpec& p : out.planes) {
+        // n' . (R x) = n . x: the position of the plane's points along its normal is unchanged.
+        p.normal = turned(plane_normal(p));
+        p.axis = -1;
+        if (const auto a = aligned_axis(p.normal, dim)) {
+            p.axis = a->axis;
+            p.position *= a->sign;
+            p.side *= a->sign;
+            p.normal = {0, 0, 0};
+        }
+    }
+    for (GaugeSpec& gauge : out.gauges) {
+        if (gauge.kind != GaugeKind::Point) {
+            throw InputError(fmt::format("rotation: gauge \"{}\" is a free-surface gauge, whose normal is a coordinate axis; "
+                                         "it does not turn",
+                                         gauge.name));
+        }
+        gauge.at = turned(gauge.at);
+    }
+    return out;
 }
 
 void validate_scene(const Scene& scene) {

@@ -14,6 +14,56 @@ namespace gpa {
 
 namespace {
 
+// The directions across a plane along which widths are measured: for an aligned plane its first
+// other axis (the radius x in axisymmetric geometry) and in 3D its second, read exactly; for an
+// oblique plane t1, the coordinate axis least along n with its part along n removed, and t2 = n x t1.
+struct Across {
+    int first_axis = -1, second_axis = -1;  // aligned planes
+    std::array<double, 3> t1{0, 0, 0}, t2{0, 0, 0};
+    template <class Field>
+    double first(const Field& x, std::size_t i) const {
+        if (first_axis >= 0) return x[static_cast<std::size_t>(first_axis)][i];
+        return t1[0] * x[0][i] + t1[1] * x[1][i] + (t1[2] != 0.0 ? t1[2] * x[2][i] : 0.0);
+    }
+    template <class Field>
+    double second(const Field& x, std::size_t i) const {
+        if (second_axis >= 0) return x[static_cast<std::size_t>(second_axis)][i];
+        return t2[0] * x[0][i] + t2[1] * x[1][i] + (t2[2] != 0.0 ? t2[2] * x[2][i] : 0.0);
+    }
+    double first(const std::array<double, 3>& x) const {
+        return first_axis >= 0 ? x[static_cast<std::size_t>(first_axis)] : t1[0] * x[0] + t1[1] * x[1] + t1[2] * x[2];
+    }
+    double second(const std::array<double, 3>& x) const {
+        return second_axis >= 0 ? x[static_cast<std::size_t>(second_axis)] : t2[0] * x[0] + t2[1] * x[1] + t2[2] * x[2];
+    }
+};
+
+Across across_of(const GhostPlane& plane, int dim) {
+    Across a;
+    if (plane.axis >= 0) {
+        a.first_axis = plane.axis == 0 ? 1 : 0;
+        a.second_axis = dim == 3 ? (plane.axis == 2 ? 1 : 2) : 0;
+        return a;
+    }
+    const auto& n = plane.normal;
+    if (dim == 2) {
+        a.t1 = {n[1], -n[0], 0.0};
+        return a;
+    }
+    int k = 0;
+    for (int c = 1; c < 3; ++c) {
+        if (std::abs(n[c]) < std::abs(n[k])) k = c;
+    }
+    std::array<double, 3> t{0, 0, 0};
+    t[k] = 1.0;
+    for (int c = 0; c < 3; ++c) t[c] -= n[k] * n[c];
+    const double length = std::sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
+    for (int c = 0; c < 3; ++c) t[c] /= length;
+    a.t1 = t;
+    a.t2 = {n[1] * t[2] - n[2] * t[1], n[2] * t[0] - n[0] * t[2], n[0] * t[1] - n[1] * t[0]};
+    return a;
+}
+
 // Node i into the extent above `plane` (measure.hpp): across the plane's first other axis (the
 // radius x in axisymmetric geometry) in 2D, along the footprint's directions in the plane in 3D;
 // with its images across the symmetry planes in `mirrors` that stand on `plane` (normal to another
@@ -21,28 +71,27 @@ namespace {
 void add_to_extent(measure::Extent& e, const NodeStore& nodes, std::size_t i, const GhostPlane& plane, bool axisymmetric,
                    double base, std::span<const GhostPlane> mirrors) {
     const int d = nodes.dim();
-    const double height = plane.distance(nodes.position[plane.axis][i]) - base;
+    const double height = plane.distance_of(nodes.position, i) - base;
     const double cell = measure::particle_cell_size(nodes.size_weight[i], d);
-    const int first = plane.axis == 0 ? 1 : 0;
-    const int second = plane.axis == 2 ? 1 : 2;  // 3D only
+    const Across across = across_of(plane, d);
     const auto add = [&](double along_first, double along_second) {
         if (d == 3) {
             measure::add_particle_3d(e, height, along_first, along_second, cell);
         } else {
-            measure::add_particle(e, height, along_first, cell, axisymmetric && first == 0);
+            measure::add_particle(e, height, along_first, cell, axisymmetric && across.first_axis == 0);
         }
     };
     if (mirrors.empty()) {  // the whole body (most scenes, every step): no images to make
-        add(nodes.position[first][i], d == 3 ? nodes.position[second][i] : 0.0);
+        add(across.first(nodes.position, i), d == 3 ? across.second(nodes.position, i) : 0.0);
         return;
     }
     const std::size_t images = std::size_t{1} << mirrors.size();
     for (std::size_t mask = 0; mask < images; ++mask) {
         std::array<double, 3> x{nodes.position[0][i], nodes.position[1][i], d == 3 ? nodes.position[2][i] : 0.0};
         for (std::size_t k = 0; k < mirrors.size(); ++k) {
-            if (mask & (std::size_t{1} << k)) x[mirrors[k].axis] = 2.0 * mirrors[k].position - x[mirrors[k].axis];
+            if (mask & (std::size_t{1} << k)) mirrors[k].reflect_point(x);
         }
-        add(x[first], x[second]);
+        add(across.first(x), d == 3 ? across.second(x) : 0.0);
     }
 }
 
@@ -73,7 +122,7 @@ void Measures::set_up(const Scene& scene, const NodeStore& nodes, std::size_t re
         const PlaneSpec& p = scene.planes[k];
         for (std::size_t b = 0; b < scene.bodies.size(); ++b) {
             if (scene.bodies[b].discretisation == Discretisation::Particles && reaches_symmetry_plane(scene, b, k)) {
-                width_mirrors_.push_back({p.name, p.axis, p.position, p.side, false, false});
+                width_mirrors_.push_back({p.name, p.axis, p.position, p.side, false, false, false, p.axis < 0 ? p.normal : std::array<double, 3>{}});
                 break;
             }
         }
@@ -82,11 +131,12 @@ void Measures::set_up(const Scene& scene, const NodeStore& nodes, std::size_t re
 
 std::vector<GhostPlane> Measures::mirrors_on(const GhostPlane& plane) const {
     std::vector<GhostPlane> out;
-    int axes = 0;
     for (const GhostPlane& m : width_mirrors_) {
-        // One plane per axis: two parallel symmetry planes would make an endless row of images.
-        if (m.axis == plane.axis || (axes & (1 << m.axis))) continue;
-        axes |= 1 << m.axis;
+        // Planes standing on `plane` (perpendicular to it and to each other): two parallel symmetry
+        // planes would make an endless row of images. (No measuring plane: axis -1 and no normal.)
+        const bool measuring = plane.axis >= 0 || plane.normal != std::array<double, 3>{};
+        if (measuring && !perpendicular(m, plane)) continue;
+        if (!std::all_of(out.begin(), out.end(), [&](const GhostPlane& o) { return perpendicular(m, o); })) continue;
         out.push_back(m);
     }
     return out;
@@ -139,6 +189,7 @@ measure::Extent Measures::particle_extent(const NodeStore& nodes, std::size_t re
 measure::Extent Measures::element_extent(const ElementMesh& m, const GhostPlane& plane, bool axisymmetric, double base) {
     // The element rule of measure.hpp: nodes lie on the boundary (no d/2), "on the plane" within
     // the face tolerance of the node's body.
+    // Element scenes have aligned planes only (validate_scene).
     const int across = plane.axis == 0 ? 1 : 0;
     return tbb::parallel_reduce(
         tbb::blocked_range<std::size_t>(0, m.nodes.size(), reduce_grain), measure::Extent{},
@@ -241,16 +292,18 @@ void Measures::local_fields(const Scene& scene, const NodeStore& nodes, std::siz
     out.measured = out.radius > 0.0;
     if (!out.measured) return;
     const int d = nodes.dim();
-    const int across = plane && plane->axis == 0 ? 1 : 0;
+    const int across = plane && plane->axis == 0 ? 1 : 0;  // element nodes (aligned planes only)
+    const Across particle_across = plane ? across_of(*plane, d) : Across{0, 0};
     // The material points, and their plastic strain and temperature.
     std::vector<measure::FieldPoint> points;
     std::vector<double> strain, heat;
     std::vector<double> face_across, face_value;
+    std::vector<std::array<double, 3>> face_position;  // of the face points, for their images
     // The face row of particles: nodes on the base now that started in the lattice row nearest
     // the plane (below the next row up), so that a second row pressed down does not mix in.
     double first_row = INFINITY;
     if (plane) {
-        for (std::size_t i = 0; i < real; ++i) first_row = std::min(first_row, plane->distance(nodes.initial_position[plane->axis][i]));
+        for (std::size_t i = 0; i < real; ++i) first_row = std::min(first_row, plane->distance_of(nodes.initial_position, i));
     }
     for (std::size_t i = 0; i < real; ++i) {
         measure::FieldPoint p;
@@ -260,9 +313,10 @@ void Measures::local_fields(const Scene& scene, const NodeStore& nodes, std::siz
         points.push_back(p);
         strain.push_back(nodes.plastic_strain[i]);
         heat.push_back(nodes.temperature[i]);
-        if (plane && plane->distance(nodes.position[plane->axis][i]) - base_height < measure::particle_cell_size(nodes.size_weight[i], d) &&
-            plane->distance(nodes.initial_position[plane->axis][i]) - first_row < 0.5 * nodes.initial_diameter[i]) {
-            face_across.push_back(nodes.position[across][i]);
+        if (plane && plane->distance_of(nodes.position, i) - base_height < measure::particle_cell_size(nodes.size_weight[i], d) &&
+            plane->distance_of(nodes.initial_position, i) - first_row < 0.5 * nodes.initial_diameter[i]) {
+            face_across.push_back(particle_across.first(nodes.position, i));
+            face_position.push_back({nodes.position[0][i], nodes.position[1][i], d == 3 ? nodes.position[2][i] : 0.0});
             face_value.push_back(nodes.plastic_strain[i]);
         }
     }
@@ -290,6 +344,7 @@ void Measures::local_fields(const Scene& scene, const NodeStore& nodes, std::siz
                     const double hc = plane->distance(m.nodes.position[plane->axis][c]) - base_height;
                     if (hb <= tol && hc <= tol) {
                         face_across.push_back(p.position[across]);
+                        face_position.push_back(p.position);
                         face_value.push_back(m.points.plastic_strain[t]);
                     }
                 }
@@ -307,7 +362,7 @@ void Measures::local_fields(const Scene& scene, const NodeStore& nodes, std::siz
         for (std::size_t mask = 1; mask < (std::size_t{1} << mirrors.size()); ++mask) {
             const auto image = [&](std::array<double, 3> x) {
                 for (std::size_t k = 0; k < mirrors.size(); ++k) {
-                    if (mask & (std::size_t{1} << k)) x[mirrors[k].axis] = 2.0 * mirrors[k].position - x[mirrors[k].axis];
+                    if (mask & (std::size_t{1} << k)) mirrors[k].reflect_point(x);
                 }
                 return x;
             };
@@ -319,9 +374,8 @@ void Measures::local_fields(const Scene& scene, const NodeStore& nodes, std::siz
                 heat.push_back(heat[q]);
             }
             for (std::size_t q = 0; q < face; ++q) {
-                std::array<double, 3> x{0, 0, 0};
-                x[static_cast<std::size_t>(across)] = face_across[q];
-                face_across.push_back(image(x)[static_cast<std::size_t>(across)]);
+                const auto x = image(face_position[q]);
+                face_across.push_back(elements ? x[static_cast<std::size_t>(across)] : particle_across.first(x));
                 face_value.push_back(face_value[q]);
             }
         }

@@ -43,17 +43,24 @@ void RigidPlanes::apply_friction(const GhostSet& ghosts, NodeStore& nodes, std::
         const GhostPlane& plane = ghosts.planes()[p];
         const NodeIndex i = ghosts.source(g);
         if (i >= real || nodes.velocity_region[i] != 0) continue;
-        const double push = -plane.side * nodes.force[plane.axis][real + g];
+        const double push = -plane.side * plane.coordinate_of(nodes.force, real + g);
         if (!(push > 0.0)) continue;
         pressing_impulse_[static_cast<std::size_t>(k)] += push * dt_avg;
         const double m = nodes.mass[i];
+        // w: the tangential part of the velocity the update would give the node (its part along
+        // the normal removed; for an aligned plane that component is skipped, exactly).
         std::array<double, 3> w{0, 0, 0};
-        double w2 = 0.0;
         for (int c = 0; c < dim; ++c) {
             if (c == plane.axis) continue;
             w[c] = nodes.velocity[c][i] + dt_avg * nodes.force[c][i] / m;
-            w2 += w[c] * w[c];
         }
+        if (plane.axis < 0) {
+            const auto& n = plane.normal;
+            const double along = n[0] * w[0] + n[1] * w[1] + n[2] * w[2];
+            for (int c = 0; c < dim; ++c) w[c] -= along * n[c];
+        }
+        double w2 = 0.0;
+        for (int c = 0; c < dim; ++c) w2 += w[c] * w[c];
         if (!(w2 > 0.0)) continue;
         const double speed = std::sqrt(w2);
         // Sticking needs M |w| / dt_avg; up to mu_s N the plane holds the node, beyond it the node slides.
@@ -109,6 +116,20 @@ void RigidPlanes::guard_penetration(const GhostSet& ghosts, NodeStore& nodes, st
             tbb::blocked_range<std::size_t>(0, real, reduce_grain), WorkAndImpulse{0.0, 0.0},
             [&](const tbb::blocked_range<std::size_t>& r, WorkAndImpulse acc) {
                 for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                    if (plane.axis < 0) {  // an oblique plane: along its normal
+                        const double gap = plane.distance_of(nodes.position, i);
+                        if (gap > 0.0) continue;
+                        const auto& n = plane.normal;
+                        const double move = plane.side * (0.01 * nodes.initial_diameter[i] - gap);
+                        for (int c = 0; c < nodes.dim(); ++c) nodes.position[c][i] += move * n[c];
+                        const double v = plane.coordinate_of(nodes.velocity, i);
+                        if (plane.side * v < 0.0) {
+                            acc[0] += 0.5 * nodes.mass[i] * v * v;
+                            acc[1] -= plane.side * nodes.mass[i] * v;
+                            for (int c = 0; c < nodes.dim(); ++c) nodes.velocity[c][i] -= v * n[c];
+                        }
+                        continue;
+                    }
                     double& x = nodes.position[plane.axis][i];
                     if (plane.distance(x) > 0.0) continue;
                     x = plane.position + plane.side * 0.01 * nodes.initial_diameter[i];

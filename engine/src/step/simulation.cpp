@@ -151,7 +151,7 @@ void Simulation::Impl::setup() {
             friction.push_back({p.friction_static, p.friction_dynamic});
         }
         planes.push_back({p.name, p.axis, p.position, p.side, p.kind == PlaneKind::Rigid && p.lift_off,
-                          p.kind == PlaneKind::Rigid, p.kind == PlaneKind::Symmetry});
+                          p.kind == PlaneKind::Rigid, p.kind == PlaneKind::Symmetry, p.axis < 0 ? p.normal : std::array<double, 3>{}});
     }
     ghosts = GhostSet(planes);
     rigid_planes.assign(std::move(rigid), std::move(friction));

@@ -18,11 +18,14 @@
 
 namespace gpa {
 
+// A plane normal to a coordinate axis (`axis`), or oblique (axis = -1, unit `normal`, position =
+// n . x of its points). An aligned plane mirrors by changing signs (exact: a ghost's ghost is its
+// source bit for bit); an oblique one by the reflection H = I - 2 n n^T.
 struct GhostPlane {
     std::string name;
     int axis = 1;
     double position = 0.0;
-    int side = +1;          // the real nodes lie above (+1) or below (-1) the plane along `axis`
+    int side = +1;          // the real nodes lie above (+1) or below (-1) the plane along `axis` (n)
     bool lift_off = false;  // pairs with its ghosts may only push (a rigid plane with lift-off)
     bool rigid = false;     // a rigid wall (its reaction is reported) rather than a symmetry plane
     // A symmetry plane of the scene: its ghosts continue the bodies (a half or quarter model), and
@@ -30,9 +33,54 @@ struct GhostPlane {
     // axisymmetric scene, whose ghosts stay out of the control as they always have.
     bool continues_body = false;
 
-    // Signed distance of a point's coordinate from the plane, positive on the real side.
+    std::array<double, 3> normal{0, 0, 0};  // axis = -1 only: the unit normal
+
+    // Signed distance of a point's coordinate (along the normal) from the plane, positive on the real side.
     double distance(double coordinate) const { return side * (coordinate - position); }
+    // The coordinate along the normal of node i (of a field of 3 component arrays), and its
+    // signed distance from the plane.
+    template <class Field>
+    double coordinate_of(const Field& x, std::size_t i) const {
+        if (axis >= 0) return x[static_cast<std::size_t>(axis)][i];
+        double sum = 0.0;
+        for (std::size_t c = 0; c < 3; ++c) {
+            if (normal[c] != 0.0) sum += normal[c] * x[c][i];
+        }
+        return sum;
+    }
+    template <class Field>
+    double distance_of(const Field& x, std::size_t i) const { return distance(coordinate_of(x, i)); }
+    std::array<double, 3> unit_normal() const {
+        if (axis < 0) return normal;
+        std::array<double, 3> n{0, 0, 0};
+        n[static_cast<std::size_t>(axis)] = 1.0;
+        return n;
+    }
+    // Mirror images across the plane: of a point, of a vector (a velocity, a force, a
+    // displacement) and of a symmetric tensor in NodeStore order (H S H; 2D: the in-plane block).
+    void reflect_point(std::array<double, 3>& x) const {
+        if (axis >= 0) {
+            x[static_cast<std::size_t>(axis)] = 2.0 * position - x[static_cast<std::size_t>(axis)];
+            return;
+        }
+        const double twice = 2.0 * (normal[0] * x[0] + normal[1] * x[1] + normal[2] * x[2] - position);
+        for (std::size_t c = 0; c < 3; ++c) x[c] -= twice * normal[c];
+    }
+    void reflect_vector(std::array<double, 3>& v) const {
+        if (axis >= 0) {
+            v[static_cast<std::size_t>(axis)] = -v[static_cast<std::size_t>(axis)];
+            return;
+        }
+        const double twice = 2.0 * (normal[0] * v[0] + normal[1] * v[1] + normal[2] * v[2]);
+        for (std::size_t c = 0; c < 3; ++c) v[c] -= twice * normal[c];
+    }
+    void reflect_tensor(int dim, std::array<double, 6>& s) const;
 };
+
+// Whether two planes' normals are perpendicular (to 1e-9; aligned planes: distinct axes). Only
+// such planes make corner ghosts together: their reflections commute, so that the image across
+// both is one point whichever comes first.
+bool perpendicular(const GhostPlane& a, const GhostPlane& b);
 
 // Which real nodes get ghosts: those closer to every plane of a corner combination than
 // base + per_diameter * d (their own diameter d). A fixed range is {range, 0}.

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "gpa/engine/node_store.hpp"
+#include "gpa/engine/orientation.hpp"
 
 namespace gpa {
 
@@ -19,11 +20,15 @@ int check_lattice_stencil(int dim, int neighbours);  // returns neighbours, or t
 
 // A plane across which the lattice continues by mirror images (a symmetry plane, the axis of an
 // axisymmetric body, a rigid plane with ghosts): bit `bit` of a mirror mask.
+// In the scene's axes its normal is axis `axis`, or `normal` for axis = -1 (an oblique plane,
+// position = n . x of its points); LatticeBlock::mirror_planes holds them in the block's own axes
+// (lattice_mirror_planes), where only planes along a lattice axis continue it.
 struct MirrorPlane {
     int axis = 1;
     double position = 0.0;
     int side = +1;  // the body lies where the coordinate is above (+1) or below (-1) the plane
     int bit = 0;
+    std::array<double, 3> normal{0, 0, 0};  // axis = -1 only
 };
 
 struct LatticeBlock {
@@ -46,10 +51,27 @@ struct LatticeBlock {
     double stencil_reach = 0.0;
     // Keeps the cells whose centre it accepts (x, z) or (x, y, z); empty: keep all.
     std::function<bool(const std::array<double, 3>&)> inside;
-    // Planes with ghosts: a stencil neighbour that falls behind them and whose mirror image is a
-    // cell of this block becomes a mirrored lattice neighbour (NodeStore::fixed_mirrors).
+    // Planes with ghosts, in the block's own axes (axis-aligned): a stencil neighbour that falls
+    // behind them and whose mirror image is a cell of this block becomes a mirrored lattice
+    // neighbour (NodeStore::fixed_mirrors).
     std::vector<MirrorPlane> mirror_planes;
+    // The block turned about `pivot` (a body's rotation, scene.hpp): everything above (origin,
+    // cells, inside, mirror planes) is in the block's own axes, and a cell centre c of those axes
+    // becomes the node at place(c) = pivot + R (c - pivot). Velocities are in the scene's axes.
+    Rotation rotation = identity_rotation;
+    std::array<double, 3> pivot{0, 0, 0};
+    std::array<double, 3> place(const std::array<double, 3>& c) const {
+        if (is_identity(rotation)) return c;
+        const auto q = turn(rotation, {c[0] - pivot[0], c[1] - pivot[1], c[2] - pivot[2]});
+        return {pivot[0] + q[0], pivot[1] + q[1], pivot[2] + q[2]};
+    }
 };
+
+// The planes of `planes` (the scene's axes) in the own axes of `block` (its rotation): an aligned
+// plane of an unrotated block as it is; otherwise those whose normal turns into a lattice axis (to
+// 1e-9), with their position and side in the block's axes. The others are left out: fixed lists
+// do not continue a lattice across a plane oblique to it (variable nodes find their ghosts by search).
+std::vector<MirrorPlane> lattice_mirror_planes(const LatticeBlock& block, const std::vector<MirrorPlane>& planes, int dim);
 
 // Appends the block's nodes to `nodes`, with mass, volume, size weight, diameter (d0 = sqrt(dx dz)
 // in 2D, dx in 3D), x0, velocity, body, material and connectivity set, and fixed lists that link

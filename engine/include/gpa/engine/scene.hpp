@@ -20,6 +20,7 @@
 #include "gpa/engine/gauges.hpp"
 #include "gpa/engine/geometry.hpp"
 #include "gpa/engine/node_set.hpp"
+#include "gpa/engine/orientation.hpp"
 #include "gpa/engine/snapshot_fields.hpp"
 #include "gpa/engine/surface.hpp"
 #include "gpa/engine/weights.hpp"
@@ -127,6 +128,11 @@ struct BodySpec {
     // Initial Cauchy stress in NodeStore order (2D: xx, zz, xz, out-of-plane; 3D: xx, yy, zz, yz,
     // xz, xy). Its deviator becomes s; its mean stress becomes an initial compression through the EOS.
     std::array<double, 6> initial_stress{0, 0, 0, 0, 0, 0};
+    // The body turned about its origin (orientation.hpp): the point x of the shape as described
+    // above lies at origin + R (x - origin); its lattice, nose and imported nodes turn with it, so
+    // that a cylinder's axis is R e_z. `velocity` and `initial_stress` are in the scene's axes.
+    // Particles in plane strain and 3D only (the identity elsewhere).
+    Rotation rotation = identity_rotation;
     std::optional<ConnectivityMode> connectivity;  // overrides SolverOptions::connectivity (particles only)
     int lattice_neighbours = 0;                    // fixed lists: 4/8 (2D), 6/18/26 (3D); 0 = 8 or 26 (particles only)
 };
@@ -146,14 +152,16 @@ enum class PlaneKind {
     Symmetry,  // a mirror plane; ghost pairs always act
 };
 
-// An axis-aligned plane with ghost (mirror) nodes (spec section 7). The axis of an
-// axisymmetric scene is a symmetry plane of its own and is not listed.
+// A plane with ghost (mirror) nodes (spec section 7). The axis of an axisymmetric scene is a
+// symmetry plane of its own and is not listed. Its normal is a coordinate axis (`axis`) or, in
+// plane strain and 3D, any direction (`axis` = -1 and `normal`; plane_normal gives either).
 struct PlaneSpec {
     std::string name;
     PlaneKind kind = PlaneKind::Rigid;
-    int axis = 1;           // normal direction: 0 = x, 1 = z in 2D; 0, 1, 2 = x, y, z in 3D
-    double position = 0.0;  // coordinate of the plane along `axis`
-    int side = +1;          // the bodies lie where the coordinate is above (+1) or below (-1) the plane
+    int axis = 1;           // normal direction: 0 = x, 1 = z in 2D; 0, 1, 2 = x, y, z in 3D; -1: `normal`
+    std::array<double, 3> normal{0, 0, 0};  // axis = -1 only: the unit normal (first dim components)
+    double position = 0.0;  // coordinate of the plane along `axis`; for axis = -1, n . x of its points
+    int side = +1;          // the bodies lie where the coordinate (n . x) is above (+1) or below (-1) the plane
     bool lift_off = true;   // rigid only: false = the paper's no-lift-off (nodes on it may not leave)
     // Rigid only: Coulomb friction (RigidPlanes::apply_friction). A node the plane pushes with N
     // sticks while the tangential force that would stop it is at most friction_static N, and
@@ -161,6 +169,10 @@ struct PlaneSpec {
     double friction_static = 0.0;
     double friction_dynamic = 0.0;
 };
+
+// The unit normal of a plane: e_axis, or `normal` for axis = -1 (as given; validate_scene checks it
+// is a unit vector).
+std::array<double, 3> plane_normal(const PlaneSpec& p);
 
 // Nodes of one body held at a prescribed velocity (a grip, a clamp, a piston): every node of
 // `body` inside the region at t = 0 keeps, in each prescribed component, the velocity
@@ -335,6 +347,15 @@ public:
 };
 
 void validate_scene(const Scene& scene);
+
+// The scene turned by `rotation` about the origin (orientation.hpp; plane strain and 3D): every
+// body's origin, rotation, velocity and initial stress, every plane's normal (its position, n . x,
+// is unchanged) and every point gauge. The run of the rotated scene is the run of the scene seen
+// in turned axes, up to what the method takes in the global frame (the per-direction
+// normalisation). Throws InputError for an axisymmetric scene, a rotation that is not one
+// (rotation_problem), prescribed-velocity regions (boxes in the scene's axes) and free-surface
+// gauges (an axis-aligned normal), which do not turn.
+Scene rotated_scene(const Scene& scene, const Rotation& rotation);
 
 // Whether scene.planes[plane] is a symmetry plane that passes through scene.bodies[body] (the
 // body's shape reaches beyond it on both sides; touching is not cutting). Such a body is filled on
