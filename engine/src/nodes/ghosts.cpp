@@ -373,7 +373,7 @@ void GhostSet::refresh(NodeStore& nodes, std::size_t real_count) const {
             // (alpha) is unchanged and its off-diagonal entries (alpha_shear) flip like the shear
             // stresses. Across an oblique one it is H A H; the per-direction normalisation, which
             // keeps the diagonal only (its alpha_shear is zero), takes the diagonal of H A H: the
-            // frame-dependence of that normalisation (docs/orientation.md).
+            // frame-dependence of that normalisation (docs/orientation.md, "Oblique planes in the step").
             const int first_shear = dim == 2 ? 2 : 3, shears = dim == 2 ? 1 : 3;
             std::array<double, 6> normalisation{};
             for (int c = 0; c < dim; ++c) normalisation[c] = nodes.alpha[c][s];
