@@ -729,17 +729,28 @@ std::vector<std::pair<double, double>> final_outline(const Simulation& sim) {
     const int dim = n.dim();
     // Heights from the body's base (measure.hpp): the plane while it stands on it, else its underside.
     const double base = sim.totals().base_height;
-    // The horizontal axes: those other than the plane's normal.
+    // The horizontal axes: those other than the plane's normal (all of them for an oblique plane,
+    // whose radii are distances from a line along its normal).
     std::vector<int> across;
     for (int c = 0; c < dim; ++c) {
         if (c != plane->axis) across.push_back(c);
     }
+    const std::array<double, 3> normal = plane_normal(*plane);
+    // A node's height above the plane, n . x - position towards the bodies (the coordinate itself for
+    // an axis-aligned plane, so that its heights are what they always were, bit for bit).
+    const auto height_above = [&](std::size_t i) {
+        if (plane->axis >= 0) return plane->side * (n.position[plane->axis][i] - plane->position);
+        double along = 0.0;
+        for (int c = 0; c < dim; ++c) along += normal[static_cast<std::size_t>(c)] * n.position[c][i];
+        return plane->side * (along - plane->position);
+    };
     // Radii from the axis of an axisymmetric scene, otherwise from the vertical through the nodes'
     // centroid.
     const bool axisymmetric = scene.geometry == GeometryKind::Axisymmetric && plane->axis == 1;
     std::array<double, 3> centre{0, 0, 0};
     if (elements) {
-        // Element bodies are 2D: one axis across the plane.
+        // Element bodies are 2D, their planes axis-aligned (validate_scene): one axis across the plane.
+        if (plane->axis < 0) return out;
         const ElementMesh& m = elements->mesh();
         if (!axisymmetric) {
             for (std::size_t i = 0; i < m.nodes.size(); ++i) centre[across[0]] += m.nodes.position[across[0]][i] / double(m.nodes.size());
@@ -756,11 +767,22 @@ std::vector<std::pair<double, double>> final_outline(const Simulation& sim) {
         for (std::size_t i = 0; i < count; ++i) {
             for (int c : across) centre[c] += n.position[c][i] / double(count);
         }
-        // A half or quarter model: the whole body's centroid lies on the symmetry planes it reaches.
+        // A half or quarter model: the whole body's centroid lies on the symmetry planes it reaches,
+        // the centroid of the share moved onto each: for an axis-aligned plane its coordinate set, for
+        // an oblique one projected along its normal. (The planes that cut one body lie on faces of its
+        // lattice cells, so they are perpendicular to one another and one projection each is exact.)
         for (std::size_t k = 0; k < scene.planes.size(); ++k) {
             for (std::size_t b = 0; b < scene.bodies.size(); ++b) {
-                if (scene.planes[k].axis != plane->axis && reaches_symmetry_plane(scene, b, k)) {
-                    centre[static_cast<std::size_t>(scene.planes[k].axis)] = scene.planes[k].position;
+                const PlaneSpec& mirror = scene.planes[k];
+                if (mirror.axis == plane->axis && mirror.axis >= 0) continue;  // along the normal: no radius changes
+                if (!reaches_symmetry_plane(scene, b, k)) continue;
+                if (mirror.axis >= 0) {
+                    centre[static_cast<std::size_t>(mirror.axis)] = mirror.position;
+                } else {
+                    const std::array<double, 3> m = plane_normal(mirror);
+                    double off = -mirror.position;
+                    for (int c = 0; c < dim; ++c) off += m[static_cast<std::size_t>(c)] * centre[static_cast<std::size_t>(c)];
+                    for (int c = 0; c < dim; ++c) centre[static_cast<std::size_t>(c)] -= off * m[static_cast<std::size_t>(c)];
                 }
             }
         }
@@ -770,16 +792,30 @@ std::vector<std::pair<double, double>> final_outline(const Simulation& sim) {
     for (std::size_t i = 0; i < count; ++i) {
         const double cell = measure::particle_cell_size(n.size_weight[i], dim);
         mean_d += cell / double(count);
-        measure::add_particle(extent, plane->side * (n.position[plane->axis][i] - plane->position) - base, 0.0, cell, false);
+        measure::add_particle(extent, height_above(i) - base, 0.0, cell, false);
     }
     const double top = std::max(extent.length(), 0.0);
     const double bin = mean_d;  // one row of nodes: narrower bins hold only inner nodes every other time
     // Only the bins that hold nodes, at most one per node, however far apart the bodies are.
     std::map<double, double> radius;  // bin index (a whole number) -> largest extent
     for (std::size_t i = 0; i < count; ++i) {
-        const double h = plane->side * (n.position[plane->axis][i] - plane->position) - base;
+        const double h = height_above(i) - base;
         double r = 0.0;
-        for (int c : across) r += (n.position[c][i] - centre[c]) * (n.position[c][i] - centre[c]);
+        if (plane->axis >= 0) {
+            for (int c : across) r += (n.position[c][i] - centre[c]) * (n.position[c][i] - centre[c]);
+        } else {
+            // The distance from the line through the centre along the normal.
+            std::array<double, 3> d{0, 0, 0};
+            double along = 0.0;
+            for (int c : across) {
+                d[static_cast<std::size_t>(c)] = n.position[c][i] - centre[c];
+                along += normal[static_cast<std::size_t>(c)] * d[static_cast<std::size_t>(c)];
+            }
+            for (int c : across) {
+                const double off = d[static_cast<std::size_t>(c)] - along * normal[static_cast<std::size_t>(c)];
+                r += off * off;
+            }
+        }
         r = std::sqrt(r);
         const double k = std::floor(std::max(h / bin, 0.0));
         const double extent_r = measure::particle_outline_radius(r, measure::particle_cell_size(n.size_weight[i], dim));

@@ -524,20 +524,49 @@ void draw_triangle(Image& img, const Area& plot, const PictureFrame& frame, cons
 }
 
 // The scene's rigid and symmetry planes the view sees edge-on, as lines of the picture plane:
-// u = c (vertical) or v = c (horizontal). 2D scenes store (x, z) as the first two coordinates, as
-// the snapshots do; a 2D plane normal to x is mirrored with the run.
+// u = c (vertical), v = c (horizontal) or, for an oblique plane, nu u + nv v = c. 2D scenes store
+// (x, z) as the first two coordinates, as the snapshots do; a 2D plane normal to x is mirrored with
+// the run, and so is an oblique one.
 struct PlaneLine {
     const PlaneSpec* plane;
     bool vertical;
-    double at;             // u or v
-    double toward_bodies;  // +1: the bodies lie towards +u (+v)
+    double at;             // u or v; an oblique line's c
+    double toward_bodies;  // +1: the bodies lie towards +u (+v), or along +(nu, nv)
+    bool oblique = false;
+    double nu = 0.0, nv = 0.0;  // an oblique line's unit normal in the picture plane
 };
+
+// An oblique plane (PlaneSpec::axis = -1) as a line: edge-on when its normal lies in the picture
+// plane (to round-off); one seen at a slant is no line and is left out, as a plane facing the
+// viewer is. A normal that projects onto a picture axis gives a vertical or horizontal line.
+void add_oblique_plane_line(std::vector<PlaneLine>& lines, const PlaneSpec& plane, bool three_d, ViewDirection view,
+                            bool mirror) {
+    const std::array<double, 3> normal = plane_normal(plane);
+    const ViewPoint n = three_d ? project(normal, view) : ViewPoint{normal[0], normal[1], 0.0};
+    const double in_picture = std::hypot(n.u, n.v);
+    if (!(std::abs(n.depth) <= 1e-9) || !(in_picture > 0.0)) return;
+    const double nu = n.u / in_picture, nv = n.v / in_picture;
+    const double at = plane.position / in_picture;  // n . x = position with n . x = in_picture (nu u + nv v)
+    if (nv == 0.0 || nu == 0.0) {
+        const bool vertical_line = nv == 0.0;
+        const double sign = vertical_line ? nu : nv;  // +-1
+        lines.push_back({&plane, vertical_line, at * sign, plane.side * sign});
+        if (mirror && vertical_line && at != 0.0) lines.push_back({&plane, true, -at * sign, -plane.side * sign});
+        return;
+    }
+    lines.push_back({&plane, false, at, static_cast<double>(plane.side), true, nu, nv});
+    if (mirror) lines.push_back({&plane, false, at, static_cast<double>(plane.side), true, -nu, nv});
+}
 
 std::vector<PlaneLine> plane_lines_of(const Scene* scene, bool three_d, ViewDirection view, bool mirror) {
     std::vector<PlaneLine> lines;
     if (!scene) return lines;
     for (const PlaneSpec& plane : scene->planes) {
-        if (plane.axis < 0 || plane.axis > (three_d ? 2 : 1)) continue;
+        if (plane.axis > (three_d ? 2 : 1)) continue;
+        if (plane.axis < 0) {
+            add_oblique_plane_line(lines, plane, three_d, view, mirror);
+            continue;
+        }
         std::array<double, 3> normal{}, point{};
         normal[static_cast<std::size_t>(plane.axis)] = 1.0;
         point[static_cast<std::size_t>(plane.axis)] = plane.position;
@@ -552,14 +581,67 @@ std::vector<PlaneLine> plane_lines_of(const Scene* scene, bool three_d, ViewDire
     return lines;
 }
 
-// Widens a drawing's extent {umin, umax} x {vmin, vmax} to hold the plane lines.
+// Widens a drawing's extent {umin, umax} x {vmin, vmax} to hold the plane lines (an oblique line
+// crosses any extent's lines of constant u or v somewhere: it widens nothing).
 void reach_to_planes(const std::vector<PlaneLine>& lines, double& umin, double& umax, double& vmin, double& vmax) {
     for (const PlaneLine& l : lines) {
+        if (l.oblique) continue;
         double& low = l.vertical ? umin : vmin;
         double& high = l.vertical ? umax : vmax;
         low = std::min(low, l.at);
         high = std::max(high, l.at);
     }
+}
+
+// Draws an oblique plane line as the straight ones are drawn (rigid: solid, with short strokes on
+// the side away from the bodies; symmetry: dashed; its name on the wall's side), stepping a pixel
+// at a time along it across the plot area. `s` is the picture's scale of lines and text. Whether
+// any of it lies in the plot area.
+bool draw_oblique_plane_line(Image& img, const Area& plot, const PictureFrame& frame, const PlaneLine& l, int s, int text_h) {
+    // The line's point nearest the origin, its direction and its normal towards the bodies, in
+    // pixels (y grows downwards, v upwards).
+    const auto [cx, cy] = frame.pixel(l.at * l.nu, l.at * l.nv);
+    const double dx = -l.nv, dy = -l.nu;
+    const double ax = -l.toward_bodies * l.nu, ay = l.toward_bodies * l.nv;  // away from the bodies
+    const double mx = 0.5 * (plot.x0 + plot.x1), my = 0.5 * (plot.y0 + plot.y1);
+    const double middle = (mx - cx) * dx + (my - cy) * dy;
+    const double reach = 0.5 * std::hypot(plot.x1 - plot.x0, plot.y1 - plot.y0) + 1.0;
+    if (!std::isfinite(middle) || std::abs((mx - cx) * ax + (my - cy) * ay) > reach) return false;
+    const auto inside = [&](double x, double y) { return x >= plot.x0 && x < plot.x1 && y >= plot.y0 && y < plot.y1; };
+    const bool dashed = l.plane->kind == PlaneKind::Symmetry;
+    const int thick = std::max(s, 1);
+    const int steps = static_cast<int>(std::ceil(2.0 * reach));
+    double first_x = 0.0, first_y = 0.0;
+    bool any = false;
+    for (int q = 0; q <= steps; ++q) {
+        const double t = middle - reach + q;
+        const double x = cx + t * dx, y = cy + t * dy;
+        if (!inside(x, y)) continue;
+        if (!any) first_x = x, first_y = y;
+        any = true;
+        if (dashed && (q / (6 * s)) % 2 == 1) continue;
+        const int px = pixel_index(std::round(x)) - s / 2, py = pixel_index(std::round(y)) - s / 2;
+        fill_rect(img, std::max(px, plot.x0), std::max(py, plot.y0), std::min(px + thick, plot.x1), std::min(py + thick, plot.y1),
+                  text_colour);
+        if (!dashed && q % (8 * s) == 3 * s) {
+            for (int k = 0; k < 5 * s; ++k) {
+                const double sx = x + k * (dx + ax), sy = y + k * (dy + ay);
+                if (inside(sx, sy)) img.set(pixel_index(std::round(sx)), pixel_index(std::round(sy)), text_colour);
+            }
+        }
+    }
+    if (!any) return false;
+    // Its name on the wall's side, a name's width in from where the line enters the plot area: the
+    // corner of the name's box nearest the line 6 s from it, the rest farther (kept within the area).
+    const std::string label = fitted(l.plane->name, (plot.x1 - plot.x0) / 2, s);
+    const int name_w = detail::text_width(label, s);
+    const double along = name_w + 8.0 * s;
+    const double lx = first_x + along * dx + 6.0 * s * ax + (ax < 0.0 ? -name_w : 0.0);
+    const double ly = first_y + along * dy + 6.0 * s * ay + (ay < 0.0 ? -text_h : 0.0);
+    const int x = std::clamp(pixel_index(std::round(lx)), plot.x0, std::max(plot.x0, plot.x1 - name_w));
+    const int y = std::clamp(pixel_index(std::round(ly)), plot.y0, std::max(plot.y0, plot.y1 - text_h));
+    draw_text(img, x, y, label, s, text_colour);
+    return true;
 }
 
 }  // namespace
@@ -972,6 +1054,10 @@ Picture render_snapshot(const LoadedSnapshot& snapshot, GeometryKind geometry, c
     // The planes: a line across the drawing (rigid: solid, with short strokes on the side away
     // from the bodies; symmetry: dashed) and the plane's name beside it on the wall's side.
     for (const PlaneLine& l : plane_lines) {
+        if (l.oblique) {
+            if (draw_oblique_plane_line(img, plot, frame, l, s, text_h)) ++picture.planes_drawn;
+            continue;
+        }
         const auto [px, py] = frame.pixel(l.vertical ? l.at : 0.0, l.vertical ? 0.0 : l.at);
         const int p = pixel_index(std::round(l.vertical ? px : py));
         if (l.vertical ? (p < plot.x0 || p >= plot.x1) : (p < plot.y0 || p >= plot.y1)) continue;

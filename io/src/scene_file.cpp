@@ -11,6 +11,7 @@
 #include <cmath>
 #include <fstream>
 #include <limits>
+#include <numbers>
 #include <optional>
 #include <sstream>
 #include <system_error>
@@ -33,15 +34,15 @@ constexpr std::uintmax_t max_scene_file_bytes = 16u << 20;
 
 const std::vector<std::string_view> scene_keys{
     "name", "description", "geometry", "material", "body", "plane", "prescribed_velocity", "gauge", "solver", "stop",
-    "output", "reference",
+    "output", "reference", "rotation",
 };
 const std::vector<std::string_view> body_keys{
     "name",    "shape",     "material", "origin",         "size",         "radius",            "diameter",
     "length",  "spacing",   "spacing_z", "velocity",      "initial_stress", "connectivity",    "lattice_neighbours",
-    "discretisation", "inner_radius", "nose", "file", "unit",
+    "discretisation", "inner_radius", "nose", "file", "unit", "rotation",
 };
-const std::vector<std::string_view> plane_keys{"name", "kind", "axis", "position", "side", "lift_off", "friction",
-                                               "static_friction"};
+const std::vector<std::string_view> plane_keys{"name", "kind", "axis", "position", "normal", "point", "side", "lift_off",
+                                               "friction", "static_friction"};
 const std::vector<std::string_view> gauge_keys{"name", "kind", "at", "body", "radius", "normal", "fields"};
 const std::vector<std::string_view> prescribed_keys{"name", "body", "region", "velocity", "ramp"};
 const std::vector<std::string_view> region_keys{"box", "above", "below", "beyond_radius", "within_radius"};
@@ -153,6 +154,53 @@ std::array<double, 3> to_vector3(const std::vector<double>& v) {
     std::array<double, 3> out{0, 0, 0};
     for (std::size_t i = 0; i < v.size() && i < 3; ++i) out[i] = v[i];
     return out;
+}
+
+// The unit vector along the first dim components of v, written in any length: nothing for a zero
+// vector. A power of two brings the largest component near 1 first (exactly), so that lengths
+// beyond the range of a double's square ([1e200, 1e200, 0]) normalise as well as any other.
+std::optional<std::array<double, 3>> direction_of(const std::array<double, 3>& v, int dim) {
+    double largest = 0.0;
+    for (int c = 0; c < dim; ++c) largest = std::max(largest, std::abs(v[c]));
+    if (!(largest > 0.0) || !std::isfinite(largest)) return std::nullopt;
+    int exponent = 0;
+    std::frexp(largest, &exponent);
+    std::array<double, 3> scaled{0, 0, 0};
+    for (int c = 0; c < dim; ++c) scaled[c] = std::ldexp(v[c], -exponent);
+    return unit_vector(scaled, dim);
+}
+
+// `rotation = { axis = [x, y, z], angle = "30 deg" }` (3D) or `rotation = { angle = "30 deg" }`
+// (plane strain) in the table `r` reads, a body's or the scene's (`in_axisymmetric` names it in an
+// axisymmetric scene, for the message); nothing when the key is absent. Axisymmetric scenes have no
+// rotations: their axis is fixed.
+std::optional<Rotation> read_rotation(const TableReader& r, GeometryKind geometry, std::string_view in_axisymmetric) {
+    const toml::node* node = r.find("rotation");
+    if (!node) return std::nullopt;
+    const int dim = dimension_of(geometry);
+    if (geometry == GeometryKind::Axisymmetric) {
+        r.fail_at("rotation", fmt::format("does not apply to {}: its symmetry axis is fixed along z (bodies and scenes turn in "
+                                          "plane-strain and 3d scenes)", in_axisymmetric));
+    }
+    const std::string_view example = dim == 3 ? "{ axis = [0, 0, 1], angle = \"30 deg\" }" : "{ angle = \"30 deg\" }";
+    const auto* table = node->as_table();
+    if (!table) r.fail_at("rotation", fmt::format("expected a table such as {}, got {}", example, as_written(*node)));
+    const TableReader t(r.reporter(), *table, r.key_path("rotation"), "a rotation", {"axis", "angle"});
+    if (dim == 2 && t.has("axis")) {
+        t.fail_at("axis", "does not apply in a plane-strain scene: a rotation there turns the (x, z) plane about y; give "
+                          "angle only (positive from x towards z)");
+    }
+    const double angle = t.required_quantity("angle", D::Angle);
+    if (!(std::abs(angle) <= 2.0 * std::numbers::pi)) {
+        t.fail_at("angle", fmt::format("{:.6g} rad ({:.6g} deg) is more than a full turn: give an angle from -360 to 360 deg (a "
+                                       "plain number is in radians; write degrees as \"30 deg\")", angle, angle * 180.0 / std::numbers::pi));
+    }
+    if (dim == 2) return rotation_in_plane(angle);
+    const auto axis = t.quantities("axis", D::Dimensionless, 3, Limit::Any, "[x, y, z]");
+    if (!axis) t.fail_missing("axis", "the direction the rotation turns about, [x, y, z] of any length, e.g. [0, 0, 1]");
+    const auto unit = direction_of(to_vector3(*axis), 3);
+    if (!unit) t.fail_at("axis", "is a zero vector: give a direction to turn about, [x, y, z] of any length, e.g. [0, 0, 1]");
+    return rotation_about(*unit, angle);
 }
 
 // --- bodies ----------------------------------------------------------------------------------
@@ -365,6 +413,12 @@ BodySpec read_body(const Reporter& reporter, const toml::table& table, std::size
     }
     b.connectivity = r.choice<ConnectivityMode>("connectivity", connectivity_words);
     if (const auto n = r.whole_number("lattice_neighbours", 0, 26)) b.lattice_neighbours = static_cast<int>(*n);
+    if (const auto rotation = read_rotation(r, geometry, "a body in an axisymmetric scene")) {
+        if (b.discretisation == Discretisation::Elements) {
+            r.fail_at("rotation", "applies to particle bodies only: an element body's mesh follows the scene's axes");
+        }
+        b.rotation = *rotation;
+    }
     return b;
 }
 
@@ -381,11 +435,48 @@ PlaneSpec read_plane(const Reporter& reporter, const toml::table& table, std::si
     if (!kind) r.fail_missing("kind", "rigid or symmetry");
     p.kind = *kind;
 
-    const auto axis = dim == 2 ? r.choice<int>("axis", {{"x", 0}, {"z", 1}})
-                               : r.choice<int>("axis", {{"x", 0}, {"y", 1}, {"z", 2}});
-    if (!axis) r.fail_missing("axis", dim == 2 ? "the plane's normal: x or z" : "the plane's normal: x, y or z");
-    p.axis = *axis;
-    p.position = r.required_quantity("position", D::Length);
+    // Where the plane lies: axis and position, or normal and a point on it. A normal along a
+    // coordinate axis becomes the axis form, so that the plane is the very one `axis` would give.
+    const std::string_view components = components_of(dim);
+    int flip = 1;  // -1 for a normal along a negative coordinate axis: the axis form's side is the other
+    if (r.has("normal")) {
+        if (r.has("axis")) r.fail_at("normal", "give axis and position, or normal and point, not both");
+        if (r.has("position")) {
+            r.fail_at("position", fmt::format("applies with axis; a plane given by its normal takes point = {} (any point on "
+                                              "it) instead", components));
+        }
+        const auto written = r.quantities("normal", D::Dimensionless, static_cast<std::size_t>(dim), Limit::Any, components);
+        const auto normal = direction_of(to_vector3(*written), dim);
+        if (!normal) r.fail_at("normal", fmt::format("is a zero vector: a normal needs a direction, {} of any length", components));
+        if (!r.has("point")) r.fail_missing("point", fmt::format("a point on the plane, {} with units (with normal)", components));
+        const auto point = to_vector3(*r.quantities("point", D::Length, static_cast<std::size_t>(dim), Limit::Any, components));
+        if (const auto aligned = aligned_axis(*normal, dim)) {
+            p.axis = aligned->axis;
+            p.position = point[static_cast<std::size_t>(aligned->axis)];
+            flip = aligned->sign;
+        } else {
+            if (geometry == GeometryKind::Axisymmetric) {
+                r.fail_at("normal", "is oblique: an axisymmetric scene takes planes normal to x or z only (a plane there turns "
+                                    "about the axis), normal = [1, 0] or [0, 1]");
+            }
+            p.axis = -1;
+            p.normal = *normal;
+            p.position = 0.0;
+            for (int c = 0; c < dim; ++c) p.position += p.normal[static_cast<std::size_t>(c)] * point[static_cast<std::size_t>(c)];
+        }
+    } else {
+        if (r.has("point")) {
+            r.fail_at("point", "applies with normal (a plane through a point, normal to a direction); with axis give position");
+        }
+        const auto axis = dim == 2 ? r.choice<int>("axis", {{"x", 0}, {"z", 1}})
+                                   : r.choice<int>("axis", {{"x", 0}, {"y", 1}, {"z", 2}});
+        if (!axis) {
+            r.fail_missing("axis", fmt::format("the plane's normal: {} (or normal = {} with point = {})",
+                                               dim == 2 ? "x or z" : "x, y or z", components, components));
+        }
+        p.axis = *axis;
+        p.position = r.required_quantity("position", D::Length);
+    }
 
     if (const toml::node* side = r.find("side")) {
         const auto* word = side->as_string();
@@ -398,6 +489,7 @@ PlaneSpec read_plane(const Reporter& reporter, const toml::table& table, std::si
                                           as_written(*side)));
         }
     }
+    p.side *= flip;
     if (const auto lift_off = r.boolean("lift_off")) {
         if (p.kind == PlaneKind::Symmetry) {
             r.fail_at("lift_off", "applies to rigid planes only (a symmetry plane always holds its nodes)");
@@ -721,8 +813,15 @@ void read_reference(const Reporter& reporter, const toml::table& table, Scene& s
     }
 }
 
-Scene read_scene(std::string_view text, const Reporter& reporter, std::vector<std::size_t>& region_lines,
-                 std::vector<std::size_t>& gauge_lines) {
+// What parse_scene needs besides the Scene: the lines of the tables the engine's checks may name
+// by index, and the top-level rotation, applied once the scene as written is checked.
+struct ReadExtras {
+    std::vector<std::size_t> region_lines, gauge_lines;
+    std::optional<Rotation> rotation;
+    std::size_t rotation_line = 0;
+};
+
+Scene read_scene(std::string_view text, const Reporter& reporter, ReadExtras& extras) {
     check_text(text, reporter);
     const toml::table root = parse_toml(text, reporter);
     if (root.empty()) {
@@ -754,12 +853,12 @@ Scene read_scene(std::string_view text, const Reporter& reporter, std::vector<st
     const auto region_tables = tables_of(top, "prescribed_velocity");
     for (std::size_t i = 0; i < region_tables.size(); ++i) {
         scene.prescribed_velocities.push_back(read_prescribed_velocity(reporter, *region_tables[i], i, scene.geometry));
-        region_lines.push_back(line_of(*region_tables[i]));
+        extras.region_lines.push_back(line_of(*region_tables[i]));
     }
     const auto gauge_tables = tables_of(top, "gauge");
     for (std::size_t i = 0; i < gauge_tables.size(); ++i) {
         scene.gauges.push_back(read_gauge(reporter, *gauge_tables[i], i, scene.geometry));
-        gauge_lines.push_back(line_of(*gauge_tables[i]));
+        extras.gauge_lines.push_back(line_of(*gauge_tables[i]));
     }
     scene.materials = scene_materials.take();
 
@@ -768,30 +867,51 @@ Scene read_scene(std::string_view text, const Reporter& reporter, std::vector<st
     scene.stop = read_stop(reporter, sub_table(top, "stop", empty));
     scene.output = read_output(reporter, sub_table(top, "output", empty));
     read_reference(reporter, sub_table(top, "reference", empty), scene);
+    extras.rotation = read_rotation(top, scene.geometry, "an axisymmetric scene");
+    if (extras.rotation) extras.rotation_line = line_of(*top.find("rotation"));
     // The neighbourhood of local peaks is fixed by the scene as written (twice its first body's
     // spacing unless given), so that the refined runs of a study measure over the same one.
     if (scene.output.peak_radius == 0.0 && !scene.bodies.empty()) scene.output.peak_radius = 2.0 * nominal_spacing(scene.bodies.front());
     return scene;
 }
 
+// The scene-level rules (shapes for the geometry, planes, spacings, option ranges, materials,
+// the nodes of prescribed-velocity regions) are the engine's, the same for a Scene built in
+// code; an error about one region or gauge points at its table. `turned`: the scene is the one
+// the top-level rotation made, which messages say.
+void check_scene(const Scene& scene, const Reporter& reporter, const ReadExtras& extras, bool turned) {
+    const std::string_view after = turned ? "after the top-level rotation: " : "";
+    try {
+        validate_scene(scene);
+    } catch (const PrescribedVelocityError& e) {
+        reporter.fail(e.index() < extras.region_lines.size() ? extras.region_lines[e.index()] : 0, "", fmt::format("{}{}", after, e.what()));
+    } catch (const GaugeError& e) {
+        reporter.fail(e.index() < extras.gauge_lines.size() ? extras.gauge_lines[e.index()] : 0, "", fmt::format("{}{}", after, e.what()));
+    } catch (const InputError& e) {
+        reporter.fail(turned ? extras.rotation_line : 0, turned ? "rotation" : "", fmt::format("{}{}", after, e.what()));
+    }
+}
+
 }  // namespace
 
 Scene parse_scene(std::string_view text, const std::string& file_name_for_messages) {
     const Reporter reporter(file_name_for_messages);
-    std::vector<std::size_t> region_lines, gauge_lines;
-    Scene scene = read_scene(text, reporter, region_lines, gauge_lines);
-    // The scene-level rules (shapes for the geometry, planes, spacings, option ranges, materials,
-    // the nodes of prescribed-velocity regions) are the engine's, the same for a Scene built in
-    // code; an error about one region points at its table.
+    ReadExtras extras;
+    Scene scene = read_scene(text, reporter, extras);
+    check_scene(scene, reporter, extras, false);
+    if (!extras.rotation) return scene;
+    // The whole scene turned about the origin, as written and checked; what cannot turn (regions,
+    // free-surface gauges) is refused at the rotation's line. The turned scene is checked again: a
+    // rule with a tolerance (a symmetry plane on the lattice's cell faces) meets turned round-off.
     try {
-        validate_scene(scene);
-    } catch (const PrescribedVelocityError& e) {
-        reporter.fail(e.index() < region_lines.size() ? region_lines[e.index()] : 0, "", e.what());
-    } catch (const GaugeError& e) {
-        reporter.fail(e.index() < gauge_lines.size() ? gauge_lines[e.index()] : 0, "", e.what());
+        scene = rotated_scene(scene, *extras.rotation);
     } catch (const InputError& e) {
-        reporter.fail(0, "", e.what());
+        // The engine's message may name the key already ("rotation: ..."): name it once.
+        const std::string_view message = e.what();
+        const bool named = message.starts_with("rotation: ");
+        reporter.fail(extras.rotation_line, "rotation", named ? message.substr(10) : message);
     }
+    check_scene(scene, reporter, extras, true);
     return scene;
 }
 

@@ -503,7 +503,7 @@ RunProbe::RunProbe(const Simulation& sim) {
     const auto first = std::find_if(planes.begin(), planes.end(), [](const PlaneSpec& p) { return p.kind == PlaneKind::Rigid; });
     if (first != planes.end() && !sim.totals().planes.empty()) {
         plane_ = 0;  // Totals::planes lists the rigid planes in scene order
-        axis_ = first->axis;
+        normal_ = plane_normal(*first);
         lift_off_ = first->lift_off;
     }
     for (std::size_t i = 0; i < sim.real_count(); ++i) mass_ += sim.nodes().mass[i];
@@ -554,7 +554,9 @@ std::map<std::string, double> RunProbe::metrics(const Simulation& sim) const {
     const bool left = lift_off_ && contact_start_ >= 0.0 && !touching_ && contact_end_ >= 0.0;
     if (left) {
         m["contact_time"] = contact_end_ - contact_start_;
-        m["rebound_speed"] = mass_ > 0.0 ? std::abs(t.momentum[static_cast<std::size_t>(axis_)]) / mass_ : nan;
+        double along = 0.0;
+        for (std::size_t c = 0; c < 3; ++c) along += normal_[c] * t.momentum[c];
+        m["rebound_speed"] = mass_ > 0.0 ? std::abs(along) / mass_ : nan;
     }
     // Measured on the body itself (docs/measurement.md), so they hold after lift-off too.
     m["final_length"] = t.length;

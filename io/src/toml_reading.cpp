@@ -53,6 +53,12 @@ std::string join(const std::vector<std::string_view>& words) {
     return out;
 }
 
+// The noun with its indefinite article: "a length", "an angle".
+std::string a_or_an(std::string_view noun) {
+    const bool vowel = !noun.empty() && std::string_view("aeiou").find(noun.front()) != std::string_view::npos;
+    return fmt::format("{} {}", vowel ? "an" : "a", noun);
+}
+
 std::string_view example_of(Dimension d) {
     switch (d) {
         case Dimension::Dimensionless: return "0.5";
@@ -65,13 +71,14 @@ std::string_view example_of(Dimension d) {
         case Dimension::SpecificHeat: return "\"452 J/kg/K\"";
         case Dimension::SpecificEnergy: return "\"1 kJ/kg\"";
         case Dimension::StrainRate: return "\"1 1/s\"";
+        case Dimension::Angle: return "\"30 deg\"";
     }
     return "";
 }
 
 std::string expected_quantity(Dimension d) {
     if (d == Dimension::Dimensionless) return "a number";
-    return fmt::format("a {} (a number in {} or a string such as {})", name_of(d), si_unit_of(d), example_of(d));
+    return fmt::format("{} (a number in {} or a string such as {})", a_or_an(name_of(d)), si_unit_of(d), example_of(d));
 }
 
 std::string noun_of(Dimension d) { return d == Dimension::Dimensionless ? "number" : std::string(name_of(d)); }
@@ -387,9 +394,9 @@ double read_quantity(const Reporter& reporter, const toml::node& node, const std
         value = static_cast<double>(i->get());
     } else if (const auto* f = node.as_floating_point()) {
         value = f->get();
-        if (std::isnan(value)) reporter.fail(line, key_path, fmt::format("nan is not allowed: a {} must be finite", noun_of(d)));
+        if (std::isnan(value)) reporter.fail(line, key_path, fmt::format("nan is not allowed: {} must be finite", a_or_an(noun_of(d))));
         if (std::isinf(value) && !(limit == Limit::PositiveOrInfinite && value > 0)) {
-            reporter.fail(line, key_path, fmt::format("{} is not allowed: a {} must be finite", as_written(node), noun_of(d)));
+            reporter.fail(line, key_path, fmt::format("{} is not allowed: {} must be finite", as_written(node), a_or_an(noun_of(d))));
         }
     } else if (const auto* s = node.as_string()) {
         try {

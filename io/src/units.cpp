@@ -3,6 +3,7 @@
 #include <array>
 #include <charconv>
 #include <cmath>
+#include <numbers>
 #include <optional>
 #include <string>
 #include <system_error>
@@ -16,7 +17,7 @@ namespace {
 constexpr std::array dimensions{
     Dimension::Dimensionless, Dimension::Length,       Dimension::Time,           Dimension::Velocity,
     Dimension::Density,       Dimension::Pressure,     Dimension::Temperature,    Dimension::SpecificHeat,
-    Dimension::SpecificEnergy, Dimension::StrainRate,
+    Dimension::SpecificEnergy, Dimension::StrainRate,   Dimension::Angle,
 };
 
 using D = Dimension;
@@ -25,6 +26,8 @@ using D = Dimension;
 // gravity 9.80665 m/s^2, both exact by definition), over (0.0254 m)^2.
 constexpr double pound_force = 4.4482216152605;
 constexpr double psi = pound_force / (0.0254 * 0.0254);
+// The degree of arc in radians.
+constexpr double degree = std::numbers::pi / 180.0;
 
 // The preferred spelling of each unit comes first within its dimension; aliases follow.
 constexpr std::array units{
@@ -88,6 +91,10 @@ constexpr std::array units{
     Unit{"1/ms", D::StrainRate, 3},
     Unit{"1/us", D::StrainRate, 6},
     Unit{"s^-1", D::StrainRate, 0, 1.0, true},
+
+    Unit{"rad", D::Angle, 0},
+    Unit{"deg", D::Angle, 0, degree},
+    Unit{"\u00B0", D::Angle, 0, degree, true},  // the degree sign
 };
 
 // The form units are compared in: '*' and the middle dot become '.', and so does white space
@@ -135,8 +142,10 @@ bool is_digit(char c) { return c >= '0' && c <= '9'; }
 // engineers write them; "J/kg/K" too). The dimension follows from the exponents of length, mass,
 // time and temperature; decimal prefixes and units join the number's exponent (no round-off of
 // their own, as for the listed units), the customary ones multiply once.
+// The plane angle counts as a base dimension of its own (SI calls it a number, m/m): so that an angle
+// is never read where a plain number is meant, nor a percentage where an angle is.
 struct Exponents {
-    int length = 0, mass = 0, time = 0, temperature = 0;
+    int length = 0, mass = 0, time = 0, temperature = 0, angle = 0;
     bool operator==(const Exponents&) const = default;
 };
 
@@ -150,6 +159,7 @@ struct Base {
 };
 
 constexpr Exponents length_e{1, 0, 0, 0}, mass_e{0, 1, 0, 0}, time_e{0, 0, 1, 0}, temperature_e{0, 0, 0, 1};
+constexpr Exponents angle_e{0, 0, 0, 0, 1};
 constexpr Exponents pressure_e{-1, 1, -2, 0}, force_e{1, 1, -2, 0}, energy_e{2, 1, -2, 0};
 
 constexpr std::array bases{
@@ -170,6 +180,9 @@ constexpr std::array bases{
     Base{"lbf", force_e, 0, pound_force},
     Base{"psi", pressure_e, 0, psi},
     Base{"ksi", pressure_e, 3, psi},
+    Base{"rad", angle_e},
+    Base{"deg", angle_e, 0, degree},
+    Base{"\u00B0", angle_e, 0, degree},
     // Words, for those who spell units out (each also with a plural s: base_unit).
     Base{"second", time_e, 0, 1.0, false, true},
     Base{"millisecond", time_e, -3, 1.0, false, true},
@@ -185,6 +198,8 @@ constexpr std::array bases{
     Base{"inches", length_e, 0, 0.0254},
     Base{"foot", length_e, 0, 0.3048},
     Base{"feet", length_e, 0, 0.3048},
+    Base{"radian", angle_e, 0, 1.0, false, true},
+    Base{"degree", angle_e, 0, degree, false, true},
 };
 
 struct Prefix {
@@ -213,6 +228,7 @@ constexpr Exponents exponents_of(Dimension d) {
         case D::SpecificHeat: return {2, 0, -2, -1};
         case D::SpecificEnergy: return {2, 0, -2, 0};
         case D::StrainRate: return {0, 0, -1, 0};
+        case D::Angle: return angle_e;
     }
     return {};
 }
@@ -236,6 +252,7 @@ std::string describe(const Exponents& e) {
     part("kg", e.mass);
     part("s", e.time);
     part("K", e.temperature);
+    part("rad", e.angle);
     return out.empty() ? std::string("1") : out;
 }
 
@@ -288,7 +305,7 @@ std::optional<Conversion> unit_factor(std::string_view term) {
     if (!c) return std::nullopt;
     Conversion out;
     out.exponents = {c->exponents.length * power, c->exponents.mass * power, c->exponents.time * power,
-                     c->exponents.temperature * power};
+                     c->exponents.temperature * power, c->exponents.angle * power};
     out.decimal_exponent = c->decimal_exponent * power;
     for (int k = 0; k < std::abs(power); ++k) out.factor = power > 0 ? out.factor * c->factor : out.factor / c->factor;
     return out;
@@ -324,6 +341,7 @@ std::optional<Conversion> compound_unit(std::string_view written) {
             total.exponents.mass += sign * f->exponents.mass;
             total.exponents.time += sign * f->exponents.time;
             total.exponents.temperature += sign * f->exponents.temperature;
+            total.exponents.angle += sign * f->exponents.angle;
             total.decimal_exponent += sign * f->decimal_exponent;
             (denominator ? divisor : total.factor) *= f->factor;
         }
@@ -422,16 +440,22 @@ std::string_view trim(std::string_view s) {
 constexpr std::string_view compound_hint =
     ", or a compound of m, g, s, Pa, N, J, bar (with the prefixes n, u, m, c, k, M, G), K, cc, min, h, in, ft, "
     "lb, lbf, psi, ksi and powers (\"mm/ms\", \"GN/m^2\", \"lbf/in^2\")";
+// Angles take their listed units and the words degree(s) and radian(s).
+constexpr std::string_view angle_hint = " (also the words degrees and radians)";
 
 std::string article_name(Dimension d) {
     if (d == Dimension::Dimensionless) return "a plain number";
-    return fmt::format("a {}", name_of(d));
+    return fmt::format("{} {}", d == Dimension::Angle ? "an" : "a", name_of(d));
 }
 
 std::string takes(Dimension d) {
     if (d == Dimension::Dimensionless) return "a plain number takes no unit (or %)";
     std::string out = fmt::format("{} takes {}, or a plain number in {}", article_name(d), accepted_units(d), si_unit_of(d));
-    if (d != Dimension::Temperature) out += compound_hint;
+    if (d == Dimension::Angle) {
+        out += angle_hint;
+    } else if (d != Dimension::Temperature) {
+        out += compound_hint;
+    }
     return out;
 }
 
@@ -489,6 +513,7 @@ std::string_view name_of(Dimension d) {
         case Dimension::SpecificHeat: return "specific heat";
         case Dimension::SpecificEnergy: return "specific energy";
         case Dimension::StrainRate: return "strain rate";
+        case Dimension::Angle: return "angle";
     }
     return "?";
 }
@@ -505,6 +530,7 @@ std::string_view si_unit_of(Dimension d) {
         case Dimension::SpecificHeat: return "J/(kg K)";
         case Dimension::SpecificEnergy: return "J/kg";
         case Dimension::StrainRate: return "1/s";
+        case Dimension::Angle: return "rad";
     }
     return "";
 }

@@ -601,6 +601,60 @@ TEST(Render, TheScenesPlanesAreLinesWhereSeenEdgeOn) {
     EXPECT_EQ(render_snapshot(s3, GeometryKind::ThreeD, o).planes_drawn, 0u);  // seen from above: faces the viewer
 }
 
+// An oblique plane (axis = -1, a unit normal) is drawn as a slanted line where the view sees it
+// edge-on, and left out where it is seen at a slant.
+TEST(Render, ObliquePlanesAreSlantedLinesWhereSeenEdgeOn) {
+    NodeStore n = three_nodes();
+    const LoadedSnapshot s = snapshot_of("oblique_planes", n);
+    Scene scene;
+    PlaneSpec ramp;
+    ramp.name = "ramp";
+    ramp.axis = -1;
+    ramp.normal = {-std::sqrt(0.5), std::sqrt(0.5), 0.0};  // the line z = x - 1 mm
+    ramp.position = -std::sqrt(0.5) * 1e-3;
+    scene.planes.push_back(ramp);
+    RenderOptions o;
+    o.field = "pressure";
+    o.scene = &scene;
+    const Picture p = render_snapshot(s, GeometryKind::PlaneStrain, o);
+    EXPECT_EQ(p.planes_drawn, 1u);
+    // The line through (2, 1) mm and (2.5, 1.5) mm: a pixel of it within one of each such point.
+    const auto near_line = [&](double u, double v) {
+        const auto [x, y] = p.frame.pixel(u, v);
+        for (int dy = -1; dy <= 1; ++dy) {
+            for (int dx = -1; dx <= 1; ++dx) {
+                if (p.image.at(static_cast<int>(std::floor(x)) + dx, static_cast<int>(std::floor(y)) + dy) == text_colour) return true;
+            }
+        }
+        return false;
+    };
+    EXPECT_TRUE(near_line(2e-3, 1e-3));
+    EXPECT_TRUE(near_line(2.5e-3, 1.5e-3));
+    EXPECT_FALSE(near_line(2e-3, 2e-3));  // away from it, between the nodes
+
+    // A line outside the drawing is not drawn (nor counted).
+    scene.planes[0].position = -std::sqrt(0.5) * 50e-3;
+    EXPECT_EQ(render_snapshot(s, GeometryKind::PlaneStrain, o).planes_drawn, 0u);
+
+    NodeStore solid(GeometryKind::ThreeD, 2);
+    solid.position[0] = {0.0, 1e-3};
+    solid.position[1] = {0.0, 1e-3};
+    solid.position[2] = {1e-3, 2e-3};
+    solid.diameter = {0.5e-3, 0.5e-3};
+    const LoadedSnapshot s3 = snapshot_of("oblique_planes_3d", solid);
+    Scene scene_3d;
+    PlaneSpec floor;
+    floor.name = "floor";
+    floor.axis = -1;
+    floor.normal = {std::sqrt(0.5), 0.0, std::sqrt(0.5)};
+    floor.position = std::sqrt(0.5) * 2e-3;  // x + z = 2 mm: between the two nodes
+    scene_3d.planes.push_back(floor);
+    o.scene = &scene_3d;
+    EXPECT_EQ(render_snapshot(s3, GeometryKind::ThreeD, o).planes_drawn, 1u);  // +y: edge-on
+    o.view = ViewDirection::MinusZ;
+    EXPECT_EQ(render_snapshot(s3, GeometryKind::ThreeD, o).planes_drawn, 0u);  // from above: at a slant
+}
+
 TEST(Render, PrescribedVelocityRegionsAreOutlinedAroundTheirNodes) {
     NodeStore n = three_nodes();
     n.velocity_region = {1, 1, 0};  // the two lower nodes held by region 0

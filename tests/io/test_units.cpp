@@ -2,6 +2,7 @@
 // own, and wrong or unknown units fail with a message that lists what the dimension accepts.
 
 #include <cstdlib>
+#include <numbers>
 #include <set>
 #include <string>
 
@@ -142,6 +143,37 @@ TEST(Units, TextThatIsNotANumberFails) {
     }
     EXPECT_NE(unit_error("1e400 m", D::Length).find("range"), std::string::npos);
     EXPECT_THROW(parse_quantity("10001/s", D::StrainRate), UnitError);  // "/s" is not a unit: write "1000 1/s"
+}
+
+// Angles (body and scene rotations) are a dimension of their own: degrees convert by pi/180 once,
+// a plain number is radians, and neither a plain number's key nor a length's takes an angle.
+TEST(Units, AnglesAreADimensionOfTheirOwn) {
+    const double degree = std::numbers::pi / 180.0;
+    EXPECT_EQ(parse_quantity("0.5 rad", D::Angle), 0.5);
+    EXPECT_EQ(parse_quantity("30 deg", D::Angle), 30.0 * degree);
+    EXPECT_EQ(parse_quantity("30\u00B0", D::Angle), 30.0 * degree);
+    EXPECT_EQ(parse_quantity("-45 \u00B0", D::Angle), -45.0 * degree);
+    EXPECT_EQ(parse_quantity("90 degrees", D::Angle), 90.0 * degree);
+    EXPECT_EQ(parse_quantity("1 degree", D::Angle), degree);
+    EXPECT_EQ(parse_quantity("2 radians", D::Angle), 2.0);
+    EXPECT_EQ(parse_any_quantity("30 deg").dimension, D::Angle);
+    EXPECT_EQ(accepted_units(D::Angle), "rad, deg");
+    EXPECT_EQ(si_unit_of(D::Angle), "rad");
+
+    const std::string length = unit_error("30 deg", D::Length);
+    EXPECT_NE(length.find("\"30 deg\" is an angle, not a length"), std::string::npos) << length;
+    const std::string number = unit_error("30 deg", D::Dimensionless);
+    EXPECT_NE(number.find("is an angle, not a plain number"), std::string::npos) << number;
+    const std::string percent = unit_error("5 %", D::Angle);
+    EXPECT_NE(percent.find("is a plain number, not an angle; an angle takes rad, deg, or a plain number in rad"), std::string::npos)
+        << percent;
+    const std::string bare = unit_error("30", D::Angle);
+    EXPECT_NE(bare.find("has no unit: write an angle as a plain number in rad or as a string with one of rad, deg"), std::string::npos)
+        << bare;
+    EXPECT_NE(unit_error("30 Deg", D::Angle).find("did you mean \"deg\""), std::string::npos);
+    // An angular speed is no quantity of a scene.
+    EXPECT_NE(unit_error("30 deg/s", D::Angle).find("which no scene value is"), std::string::npos);
+    EXPECT_FALSE(compound_unit_value("deg/s").has_value());
 }
 
 TEST(Units, AnyDimensionComesFromTheUnit) {

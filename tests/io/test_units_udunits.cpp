@@ -5,6 +5,8 @@
 // 2000 values of Units.DecimalUnitsAreRoundOffExact come out one rounding off the decimal value;
 // it reads "J/kg.K" as J K / kg where engineers mean J/(kg K); and it needs its XML database at
 // run time, a file a program embedding gpa would have to ship. Measured 2026-12-03, UDUNITS 2.2.28.)
+// UDUNITS-2 has no symbol "deg": the degree is its "degree" (or the sign), and gpa's is compared
+// with that.
 
 #include <memory>
 #include <string>
@@ -64,10 +66,18 @@ TEST(UnitsAgainstUdunits, EveryListedAndCompoundSpellingHasTheReferenceValue) {
         spellings.emplace_back(compound);
         decimal.push_back(false);
     }
+    for (const char* compound : {"degrees", "degree", "\u00B0"}) {
+        spellings.emplace_back(compound);
+        decimal.push_back(false);
+    }
+    for (const char* compound : {"radians", "rad"}) {
+        spellings.emplace_back(compound);
+        decimal.push_back(true);
+    }
     for (std::size_t k = 0; k < spellings.size(); ++k) {
         const std::string& unit = spellings[k];
         const auto ours = parse_any_quantity("1 " + unit);
-        const double theirs = reference_value(reference.system, unit, ours.dimension);
+        const double theirs = reference_value(reference.system, unit == "deg" ? "degree" : unit, ours.dimension);
         ASSERT_FALSE(std::isnan(theirs)) << unit << ": UDUNITS-2 does not read it as a " << name_of(ours.dimension);
         // Decimal units: ours is the correctly rounded power of ten, theirs a product of rounded
         // factors: two roundings (4.5e-16). Customary ones: one rounding per factor or power on

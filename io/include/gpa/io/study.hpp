@@ -173,7 +173,7 @@ public:
 
 private:
     int plane_ = -1;  // index of the first rigid plane in Totals::planes (-1: none)
-    int axis_ = 1;
+    std::array<double, 3> normal_{0, 1, 0};  // the first rigid plane's unit normal
     bool lift_off_ = false;
     double mass_ = 0.0;
     double previous_time_ = 0.0;

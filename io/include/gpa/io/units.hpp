@@ -26,6 +26,7 @@ enum class Dimension {
     SpecificHeat,    // J/(kg K)
     SpecificEnergy,  // J/kg
     StrainRate,      // 1/s
+    Angle,           // rad: a plane angle (body and scene rotations)
 };
 
 // Every dimension, in the order of the enum (for documentation and tests).
@@ -35,7 +36,7 @@ std::span<const Dimension> all_dimensions();
 std::string_view name_of(Dimension d);
 
 // The SI unit a plain number is read in: "m", "s", "m/s", "kg/m^3", "Pa", "K", "J/(kg K)",
-// "J/kg", "1/s"; empty for dimensionless numbers.
+// "J/kg", "1/s", "rad"; empty for dimensionless numbers.
 std::string_view si_unit_of(Dimension d);
 
 struct Unit {
@@ -77,8 +78,9 @@ struct Quantity {
 Quantity parse_any_quantity(std::string_view text);
 
 // One unit read as a compound: products and quotients of the base units m, g, s, Pa, N, J, bar
-// (each with an optional SI prefix n, u, m, c, k, M, G), K, cc, min, h, in, ft, lb, lbf, psi, ksi
-// (and spelt-out words such as "microseconds" or "feet"), each with an optional integer power
+// (each with an optional SI prefix n, u, m, c, k, M, G), K, cc, min, h, in, ft, lb, lbf, psi, ksi,
+// rad, deg and the degree sign (and spelt-out words such as "microseconds", "feet" or "degrees"),
+// each with an optional integer power
 // ("m^3", "m3", "s^-1"); a space, '.', '*' or the middle dot multiplies, and everything after the
 // first '/' divides ("J/kg.K" and "J/(kg K)" are both J/(kg K); parentheses may enclose the whole
 // denominator only), with "1/s" for a numerator of one. Returns the SI value of one such unit and
