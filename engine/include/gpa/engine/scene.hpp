@@ -378,7 +378,9 @@ int symmetry_copies(const Scene& scene, std::size_t body);
 // reach about 10 km/s, orbital debris 15 km/s), a body smaller than 10 um or larger than 10 m
 // across, an end time beyond 0.1 s (impacts last micro- to milliseconds). One message per finding,
 // naming the body or key, its value and what to check; empty when nothing is odd. They are
-// warnings (gpa check and gpa run print them), never refusals: such a scene may be meant.
+// warnings (gpa check and gpa run print them), never refusals: such a scene may be meant. Also
+// one combination of options that works but less well than another: an oblique plane under the
+// per-direction normalisation (docs/orientation.md).
 std::vector<std::string> scene_warnings(const Scene& scene);
 
 }  // namespace gpa
