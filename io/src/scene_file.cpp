@@ -693,9 +693,15 @@ PrescribedVelocitySpec read_prescribed_velocity(const Reporter& reporter, const 
 
 // Every key of the engine's table of solver options, read through the code that study variants
 // use too (solver_reading.hpp); their ranges are validate_scene's.
+// A `preset` (solver_options.hpp, SolverPreset) applies first; the keys beside it override it.
 SolverOptions read_solver(const Reporter& reporter, const toml::table& table) {
-    const TableReader r(reporter, table, "solver", "[solver]", solver_option_keys());
+    std::vector<std::string_view> keys = solver_option_keys();
+    keys.push_back("preset");
+    const TableReader r(reporter, table, "solver", "[solver]", keys);
     SolverOptions s;
+    std::vector<std::string_view> presets;
+    for (const SolverPreset& p : solver_presets()) presets.push_back(p.name);
+    if (const auto index = r.word_index("preset", presets)) apply_solver_preset(solver_presets()[*index], s);
     for (const SolverOption& option : solver_option_table()) read_solver_option(r, option, s);
     return s;
 }

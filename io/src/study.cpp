@@ -90,7 +90,7 @@ const std::vector<std::pair<std::string_view, Discretisation>> discretisation_wo
 std::string allowed_keys() {
     std::string s;
     for (const auto& option : solver_option_table()) s += fmt::format("{}{}", s.empty() ? "" : ", ", option.key);
-    return s + ", discretisation, threads";
+    return s + ", preset, discretisation, threads";
 }
 
 // A row's values for the help text: "fixed|variable|automatic", "NUMBER", "TIME", "true|false", "N".
@@ -350,6 +350,10 @@ Variant parse_variant(std::string_view text) {
             SolverOptions scratch;
             detail::read_solver_option_text(*option, value, fmt::format("--variant '{}'", text), scratch);
             if (const auto message = option_error(*option, scratch)) throw fail(*message);
+        } else if (key == "preset") {
+            if (!find_solver_preset(value)) {
+                throw fail(fmt::format("preset must be one of {}, not '{}'", solver_preset_list(false), value));
+            }
         } else if (key == "discretisation") {
             if (std::none_of(discretisation_words.begin(), discretisation_words.end(),
                              [&](const auto& w) { return value == w.first; })) {
@@ -363,7 +367,7 @@ Variant parse_variant(std::string_view text) {
         } else {
             // A near miss of a key is named, as the scene reader does.
             std::vector<std::string_view> keys = solver_option_keys();
-            keys.insert(keys.end(), {"discretisation", "threads"});
+            keys.insert(keys.end(), {"preset", "discretisation", "threads"});
             if (const auto near = detail::closest(key, keys)) throw fail(fmt::format("unknown key '{}'; did you mean '{}'?", key, *near));
             throw fail(fmt::format("unknown key '{}'; keys: {}", key, allowed_keys()));
         }
@@ -377,11 +381,18 @@ std::string variant_keys_help() {
     for (const auto& option : solver_option_table()) {
         s += fmt::format("{}{}={}", s.empty() ? "" : ", ", option.key, values_help(option));
     }
-    return s + ", discretisation=particles|elements, threads=N";
+    std::string presets;
+    for (const SolverPreset& p : solver_presets()) presets += fmt::format("{}{}", presets.empty() ? "" : "|", p.name);
+    return s + ", preset=" + presets + ", discretisation=particles|elements, threads=N";
 }
 
 void apply_variant(const Variant& variant, Scene& scene) {
+    // A preset first, as in a scene file: the variant's other solver keys override it.
     for (const auto& setting : variant.settings) {
+        if (setting.first == "preset") apply_solver_preset(*find_solver_preset(setting.second), scene.solver);
+    }
+    for (const auto& setting : variant.settings) {
+        if (setting.first == "preset") continue;
         // Plain names, not a structured binding: clang 14 (the sanitizer build) refuses lambdas
         // that capture one.
         const std::string& key = setting.first;

@@ -9,6 +9,7 @@
 
 #include <gtest/gtest.h>
 
+#include "gpa/engine/solver_options.hpp"
 #include "gpa/io/material_library.hpp"
 #include "gpa/io/scene_file.hpp"
 
@@ -537,6 +538,43 @@ TEST(SceneFile, DocumentationExamplesParse) {
 }
 
 // The project's own scenes (scenes/*.toml) all read.
+TEST(SceneFile, APresetSetsItsKeysAndTheKeysBesideItOverrideIt) {
+    const std::string body = R"toml(
+[[body]]
+shape = "rectangle"
+material = "rubber"
+size = ["4 mm", "4 mm"]
+spacing = "1 mm"
+)toml";
+    const Scene taylor = parse_scene(minimal_head + elastic_material + body + "[solver]\npreset = \"taylor-bar\"\n", "scene.toml");
+    EXPECT_EQ(taylor.solver.weight, WeightKind::SphNsf);
+    EXPECT_EQ(taylor.solver.influence_distance, 1.3);
+    EXPECT_EQ(taylor.solver.normalisation, Normalisation::PerDirection);
+    // A key beside the preset wins, before or after it in the table.
+    for (const std::string solver : {"[solver]\ninfluence_distance = 1.2\npreset = \"taylor-bar\"\n",
+                                     "[solver]\npreset = \"taylor-bar\"\ninfluence_distance = 1.2\n"}) {
+        const Scene s = parse_scene(minimal_head + elastic_material + body + solver, "scene.toml");
+        EXPECT_EQ(s.solver.influence_distance, 1.2);
+        EXPECT_EQ(s.solver.weight, WeightKind::SphNsf);
+    }
+    // "paper" is today's defaults, named.
+    const Scene paper = parse_scene(minimal_head + elastic_material + body + "[solver]\npreset = \"paper\"\n", "scene.toml");
+    const SolverOptions defaults;
+    EXPECT_EQ(paper.solver.weight, defaults.weight);
+    EXPECT_EQ(paper.solver.influence_distance, defaults.influence_distance);
+    EXPECT_EQ(paper.solver.normalisation, defaults.normalisation);
+    // Every preset names rows of the table with values they accept.
+    for (const SolverPreset& p : solver_presets()) {
+        SolverOptions o;
+        apply_solver_preset(p, o);
+        for (const SolverOption& option : solver_option_table()) EXPECT_FALSE(option_error(option, o).has_value()) << p.name;
+    }
+    // An unknown name: the line, the key, the presets and the nearest.
+    const std::string text = minimal_head + elastic_material + body + "[solver]\npreset = \"tailor-bar\"\n";
+    EXPECT_EQ(error_of(text), "scene.toml:19: solver.preset: \"tailor-bar\" is not one of \"paper\" or \"taylor-bar\" (did you "
+                              "mean \"taylor-bar\"?)");
+}
+
 TEST(SceneFile, ProjectScenesParse) {
     const std::filesystem::path dir = GPA_SCENES_DIR;
     if (!std::filesystem::is_directory(dir)) GTEST_SKIP() << "no " << dir;

@@ -261,6 +261,16 @@ Scene bar_scene(bool lift_off) {
     return s;
 }
 
+TEST(StudyVariants, APresetAppliesFirstAndTheVariantsKeysOverrideIt) {
+    Scene s = bar_scene(true);
+    apply_variant(parse_variant("x:influence_distance=1.2,preset=taylor-bar,cfl=0.3"), s);
+    EXPECT_EQ(s.solver.weight, WeightKind::SphNsf);
+    EXPECT_DOUBLE_EQ(s.solver.influence_distance, 1.2);
+    EXPECT_DOUBLE_EQ(s.solver.cfl, 0.3);
+    EXPECT_EQ(input_error([&] { parse_variant("x:preset=nsf"); }),
+              "--variant 'x:preset=nsf': preset must be one of paper, taylor-bar, not 'nsf'");
+}
+
 TEST(StudyVariants, ApplyChangesTheSolverAndChecksTheScene) {
     Scene s = bar_scene(true);
     apply_variant(parse_variant("x:connectivity=automatic,weight=sph-nsf,viscosity=bond,smoothing=everywhere,"

@@ -2,6 +2,8 @@
 
 #include <cmath>
 #include <limits>
+#include <stdexcept>
+#include <string>
 #include <type_traits>
 #include <utility>
 
@@ -239,6 +241,59 @@ std::optional<std::string> option_error(const SolverOption& option, const Solver
             }
         },
         option.kind);
+}
+
+std::span<const SolverPreset> solver_presets() {
+    // docs/validation.md has the measurements behind each.
+    static const std::vector<SolverPreset> presets{
+        {"paper",
+         "the paper's kernel: its weight R = 1 - v/2 (Eq. 1b) at a = 1 with the per-direction geometry factors; best on "
+         "the elastic bar, spall, perforation and the stretched bar",
+         {{"weight", "gpa"}, {"influence_distance", "1"}, {"normalisation", "per-direction"}}},
+        {"taylor-bar",
+         "the SPH-NSF cubic spline at a = 1.3 with the per-direction factors: within 0.6 % of converged elements on "
+         "every Johnson-Cook Taylor bar, worse than the paper's on the other scenes",
+         {{"weight", "sph-nsf"}, {"influence_distance", "1.3"}, {"normalisation", "per-direction"}}},
+    };
+    return presets;
+}
+
+const SolverPreset* find_solver_preset(std::string_view name) {
+    for (const SolverPreset& p : solver_presets()) {
+        if (p.name == name) return &p;
+    }
+    return nullptr;
+}
+
+std::string solver_preset_list(bool quoted) {
+    std::string s;
+    for (const SolverPreset& p : solver_presets()) {
+        s += fmt::format("{}{}{}{}", s.empty() ? "" : ", ", quoted ? "\"" : "", p.name, quoted ? "\"" : "");
+    }
+    return s;
+}
+
+void apply_solver_preset(const SolverPreset& preset, SolverOptions& s) {
+    for (const auto& [key, value] : preset.settings) {
+        const SolverOption* option = find_solver_option(key);
+        if (!option) throw std::logic_error(fmt::format("preset {}: {} is no solver option", preset.name, key));
+        std::visit(
+            [&](const auto& row) {
+                using Row = std::decay_t<decltype(row)>;
+                if constexpr (std::is_same_v<Row, NumberOption>) {
+                    s.*row.member = std::stod(std::string(value));
+                } else if constexpr (std::is_same_v<Row, WholeNumberOption>) {
+                    s.*row.member = static_cast<std::size_t>(std::stoull(std::string(value)));
+                } else if constexpr (std::is_same_v<Row, BooleanOption>) {
+                    s.*row.member = value == "true";
+                } else {
+                    const auto v = row.value_of(value);
+                    if (!v) throw std::logic_error(fmt::format("preset {}: {} is no word of {}", preset.name, value, key));
+                    row.set(s, *v);
+                }
+            },
+            option->kind);
+    }
 }
 
 }  // namespace gpa

@@ -14,6 +14,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <variant>
 #include <vector>
 
@@ -109,5 +110,27 @@ std::string option_allowed_text(const SolverOption& option);
 // Whether the row's member in `s` is allowed: nullopt if so, else the message that
 // validate_scene throws, "solver.cfl = 2 is outside (0, 1]".
 std::optional<std::string> option_error(const SolverOption& option, const SolverOptions& s);
+
+// A named set of solver settings ([solver] preset = "NAME" in a scene file, preset=NAME in a `gpa
+// study` variant): its keys are rows of the table, their values written as a scene file writes
+// them (words, plain numbers). A preset applies first; the table's keys given beside it override
+// it. Presets name measured choices, so that a scene states which one it makes and keeps it if a
+// default changes (docs/scene-format.md, "Presets").
+struct SolverPreset {
+    std::string_view name;
+    std::string_view meaning;  // one line for help and docs
+    std::vector<std::pair<std::string_view, std::string_view>> settings;
+};
+
+std::span<const SolverPreset> solver_presets();
+
+// The preset called `name`; nullptr for none.
+const SolverPreset* find_solver_preset(std::string_view name);
+
+// "\"paper\", \"taylor-bar\"" (quoted = true) or "paper, taylor-bar".
+std::string solver_preset_list(bool quoted);
+
+// Sets the preset's options in `s` (the others are left as they are).
+void apply_solver_preset(const SolverPreset& preset, SolverOptions& s);
 
 }  // namespace gpa
