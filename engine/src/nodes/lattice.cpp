@@ -72,11 +72,15 @@ std::vector<MirrorPlane> lattice_mirror_planes(const LatticeBlock& block, const 
         if (p.axis >= 0) n[static_cast<std::size_t>(p.axis)] = 1.0; else n = p.normal;
         // n . x = c with x = pivot + R (x_b - pivot): n_b . (x_b - pivot) = c - n . pivot, n_b = R^T n.
         const auto nb = turn_back(block.rotation, n);
-        int axis = -1;
-        for (int c = 0; c < dim; ++c) {
-            if (std::abs(std::abs(nb[c]) - 1.0) < 1e-9) axis = c;
+        // Along a lattice axis: every other component below 1e-9 (an angle of 1e-9 rad, the
+        // tolerance of GhostPlane's `perpendicular` too).
+        int axis = 0;
+        for (int c = 1; c < dim; ++c) {
+            if (std::abs(nb[c]) > std::abs(nb[axis])) axis = c;
         }
-        if (axis < 0) continue;
+        bool along = true;
+        for (int c = 0; c < dim; ++c) along = along && (c == axis || std::abs(nb[c]) < 1e-9);
+        if (!along) continue;
         const int sign = nb[axis] > 0.0 ? +1 : -1;
         double offset = p.position;
         for (int c = 0; c < dim; ++c) offset -= n[c] * block.pivot[c];

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdint>
 #include <exception>
+#include <numbers>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -165,6 +166,14 @@ std::pair<double, double> extent_along(const BodySpec& b, GeometryKind g, const 
     return {at_origin + lo, at_origin + hi};
 }
 
+// Where imported node x (its file's coordinates, metres) of body b is placed: origin + R x
+// (bodies.cpp, add_imported_nodes).
+std::array<double, 3> imported_node_at(const BodySpec& b, const std::array<double, 3>& x, int dim) {
+    const std::array<double, 3> given{x[0], x[1], dim == 3 ? x[2] : 0.0};
+    const auto turned = is_identity(b.rotation) ? given : turn(b.rotation, given);
+    return {turned[0] + b.origin[0], turned[1] + b.origin[1], dim == 3 ? turned[2] + b.origin[2] : 0.0};
+}
+
 // The interval a body occupies along an axis (before any node is placed).
 std::pair<double, double> extent(const BodySpec& b, GeometryKind g, int axis) {
     if (is_identity(b.rotation)) return axis_extent(b, g, axis);
@@ -245,11 +254,9 @@ void check_overlap(const Scene& scene, std::size_t a, std::size_t b) {
     };
     if (first.shape == ShapeKind::Nodes) {
         // Its own nodes, all of them.
-        const auto& o = first.origin;
         const NodeSetShape& set = *first.node_set;
         for (std::size_t k = 0; k < set.size(); ++k) {
-            const auto& x = set.set().positions[k];
-            const std::array<double, 3> p{x[0] + o[0], x[1] + o[1], dim == 3 ? x[2] + o[2] : 0.0};
+            const auto p = imported_node_at(first, set.set().positions[k], dim);
             if (!inside_shape(second, g, p)) continue;
             if (overlapping++ == 0) example = p;
         }
@@ -517,9 +524,12 @@ void check_plane(const Scene& scene, const PlaneSpec& p, std::size_t i) {
                              "cone around the axis)", label));
         }
         double q = 0.0;
-        for (int c = 0; c < dim; ++c) q += p.normal[c] * p.normal[c];
+        for (int c = 0; c < 3; ++c) q += p.normal[c] * p.normal[c];
         if (!finite(q) || std::abs(q - 1.0) > 1e-12) {
             fail(fmt::format("{}.normal must be a finite unit vector (its length squared is {})", label, q));
+        }
+        if (dim == 2 && p.normal[2] != 0.0) {
+            fail(fmt::format("{}.normal has a third component ({}) in a 2D scene, whose normals are [x, z]", label, p.normal[2]));
         }
         for (std::size_t k = 0; k < scene.bodies.size(); ++k) {
             if (scene.bodies[k].discretisation == Discretisation::Elements) {
@@ -663,6 +673,12 @@ bool any_initial_node(const Scene& scene, std::size_t b, const std::array<double
                       F&& visit) {
     const int dim = dimension_of(scene.geometry);
     if (const BodySpec& spec = scene.bodies[b]; spec.shape == ShapeKind::Nodes) {  // its imported nodes
+        if (!is_identity(spec.rotation)) {  // turned: every node, placed
+            for (std::size_t k = 0; k < spec.node_set->size(); ++k) {
+                if (visit(imported_node_at(spec, spec.node_set->set().positions[k], dim))) return true;
+            }
+            return false;
+        }
         const auto& o = spec.origin;
         std::array<double, 3> from = lo, to = hi;
         for (int c = 0; c < dim; ++c) {
@@ -779,6 +795,11 @@ void check_prescribed_velocity(const Scene& scene, std::size_t k) {
                               r.radius_min, r.radius_max));
     }
     const BodySpec& spec = *body;
+    if (!is_identity(spec.rotation) && (r.radius_min > 0.0 || std::isfinite(r.radius_max))) {
+        fail_here(fmt::format("{}.region: its radii are measured from the line along z through body \"{}\"'s centre, which "
+                              "is not the axis of a turned body; give the region as bounds along x, y and z",
+                              label, spec.name));
+    }
     std::string spans;
     bool outside = shape_known(spec) && r.radius_min > largest_radius(spec, g) * (1.0 + 1e-12);
     for (int c = 0; c < dim && shape_known(spec); ++c) {
@@ -841,19 +862,24 @@ void check_prescribed_velocity(const Scene& scene, std::size_t k) {
     }
     for (std::size_t p = 0; p < scene.planes.size(); ++p) {
         const PlaneSpec& plane = scene.planes[p];
-        if (plane.axis == -1) {  // an oblique plane: any prescribed motion with a part along its normal
+        if (plane.axis == -1) {  // an oblique plane: a prescribed velocity with a part along its normal
             const auto n = plane_normal(plane);
-            bool along = false;
-            for (int c = 0; c < dim; ++c) along = along || (moves_along(c) && n[c] != 0.0);
+            double normal_part = 0.0;
+            for (int c = 0; c < dim; ++c) {
+                if (r.velocity[c]) normal_part += *r.velocity[c] * n[c];
+            }
+            const bool along = normal_part != 0.0;
             const bool touching = along && any_initial_node(scene, b, r.lower, r.upper, [&](const auto& q) {
                 double at = 0.0;
                 for (int c = 0; c < dim; ++c) at += n[c] * q[c];
                 return inside(r, q) && std::abs(at - plane.position) < 0.75 * d0;
             });
             if (touching) {
-                fail_here(fmt::format("{} moves nodes that touch {} with a part along its normal: they would be driven {} "
-                                      "it; hold the components along its normal at 0 there or keep the region off the plane",
-                                      label, plane_label(plane, p), plane.kind == PlaneKind::Rigid ? "into or off" : "off"));
+                fail_here(fmt::format("{} moves nodes that touch {} at {} m/s along its normal (the prescribed components' "
+                                      "part along it): they would be driven {} it; prescribe a velocity in the plane, "
+                                      "or keep the region off the plane",
+                                      label, plane_label(plane, p), normal_part,
+                                      plane.kind == PlaneKind::Rigid ? "into or off" : "off"));
             }
             continue;
         }
@@ -1088,6 +1114,13 @@ Scene rotated_scene(const Scene& scene, const Rotation& rotation) {
         // n' . (R x) = n . x: the position of the plane's points along its normal is unchanged.
         p.normal = turned(plane_normal(p));
         p.axis = -1;
+        // A quarter turn leaves round-off (cos(pi/2) = 6e-17) where the normal lies along an axis:
+        // such a normal is that axis, so that the plane keeps the aligned plane's exact reflections.
+        for (int c = 0; c < dim; ++c) {
+            if (std::abs(std::abs(p.normal[c]) - 1.0) < 1e-12) {
+                for (int k = 0; k < 3; ++k) p.normal[k] = k == c ? (p.normal[c] > 0.0 ? 1.0 : -1.0) : 0.0;
+            }
+        }
         if (const auto a = aligned_axis(p.normal, dim)) {
             p.axis = a->axis;
             p.position *= a->sign;
@@ -1105,6 +1138,56 @@ Scene rotated_scene(const Scene& scene, const Rotation& rotation) {
     }
     return out;
 }
+
+namespace {
+
+// Planes in other orientations (docs/orientation.md). The symmetry planes that reach one body must
+// be parallel or perpendicular to one another, so that their images make one set of mirror copies
+// (GhostSet combines perpendicular planes only). A body with fixed lattice lists (fixed or
+// automatic connectivity) meets a plane only through the mirror images of its lattice neighbours,
+// which need the plane along one of its lattice axes (lattice_mirror_planes; the same 1e-9).
+void check_orientations(const Scene& scene) {
+    const int dim = dimension_of(scene.geometry);
+    for (std::size_t b = 0; b < scene.bodies.size(); ++b) {
+        const BodySpec& body = scene.bodies[b];
+        for (std::size_t k = 0; k < scene.planes.size(); ++k) {
+            if (!reaches_symmetry_plane(scene, b, k)) continue;
+            for (std::size_t m = k + 1; m < scene.planes.size(); ++m) {
+                if (!reaches_symmetry_plane(scene, b, m)) continue;
+                const auto n = plane_normal(scene.planes[k]), o = plane_normal(scene.planes[m]);
+                const double cosine = std::abs(n[0] * o[0] + n[1] * o[1] + n[2] * o[2]);
+                if (cosine > 1e-9 && cosine < 1.0 - 1e-9) {
+                    fail(fmt::format("{} and {} both reach {} at {:.6g} degrees to each other: the symmetry planes of one body "
+                                     "must be parallel or perpendicular, so that their mirror images are copies of the whole",
+                                     plane_label(scene.planes[k], k), plane_label(scene.planes[m], m), body_label(body, b),
+                                     std::acos(cosine) * 180.0 / std::numbers::pi));
+                }
+            }
+        }
+        const ConnectivityMode mode = body.connectivity.value_or(scene.solver.connectivity);
+        if (body.discretisation != Discretisation::Particles || body.shape == ShapeKind::Nodes || mode == ConnectivityMode::Variable) {
+            continue;
+        }
+        for (std::size_t k = 0; k < scene.planes.size(); ++k) {
+            const auto nb = turn_back(body.rotation, plane_normal(scene.planes[k]));
+            int axis = 0;
+            for (int c = 1; c < dim; ++c) {
+                if (std::abs(nb[c]) > std::abs(nb[axis])) axis = c;
+            }
+            bool along = true;
+            for (int c = 0; c < dim; ++c) along = along && (c == axis || std::abs(nb[c]) < 1e-9);
+            if (along) continue;
+            fail(fmt::format("{} uses {} connectivity, and {} is oblique to its lattice (its normal in the body's own axes is "
+                             "[{:.6g}, {:.6g}{}]): fixed nodes meet a plane only through the mirror images of their lattice "
+                             "neighbours, which needs the plane along a lattice axis; give the body variable connectivity, or "
+                             "turn the body with the plane",
+                             body_label(body, b), mode == ConnectivityMode::Fixed ? "fixed" : "automatic",
+                             plane_label(scene.planes[k], k), nb[0], nb[1], dim == 3 ? fmt::format(", {:.6g}", nb[2]) : std::string()));
+        }
+    }
+}
+
+}  // namespace
 
 void validate_scene(const Scene& scene) {
     const GeometryKind g = scene.geometry;
@@ -1141,6 +1224,8 @@ void validate_scene(const Scene& scene) {
             }
         }
     }
+
+    check_orientations(scene);
 
     for (std::size_t i = 0; i < scene.bodies.size(); ++i) {
         for (std::size_t j = i + 1; j < scene.bodies.size(); ++j) check_overlap(scene, i, j);
