@@ -289,6 +289,67 @@ void forces_impl(const CompressedRows& lists, const ScatterPlan& plan, const Bon
     }
 }
 
+// The stress-difference form (Eq. 28): each real centre gathers its own force over its row
+// (kernels.hpp, stress_difference_term, OneSidedness), in the colours of `plan` because a ghost
+// neighbour's term is written, reversed, on the ghost (the planes' reactions and pushes read the
+// forces on ghosts). Ghost centres make no force.
+template <class G, class W, bool full>
+void stress_difference_impl(const CompressedRows& lists, const ScatterPlan& plan, const ForceFields<G::dim>& f,
+                            std::size_t node_count) {
+    constexpr int D = G::dim;
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, node_count, 4096),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                          for (int c = 0; c < D; ++c) {
+                              std::fill(f.force[c] + r.begin(), f.force[c] + r.end(), 0.0);
+                          }
+                      });
+    const std::size_t real = f.hoop_count;
+    const auto centre = [&](std::size_t i) {
+        if (i >= real) return;
+        const Mat<D> sigma_i = cauchy_stress<G>(f.deviatoric_stress, f.pressure, f.viscous_pressure, i);
+        Mat<D> normalisation;
+        if constexpr (full) {
+            normalisation = normalisation_of<D>(f.alpha, f.alpha_shear, i);
+        } else {
+            normalisation = load<D>(f.alpha, i).asDiagonal();
+        }
+        const double volume = f.volume[i];
+        const auto row = lists.row(i);
+        OneSidedness<D> sides;
+        for (NodeIndex j : row) sides.add_first(f.pairs.template pair<W>(i, j), f.size_weight[j]);
+        for (NodeIndex j : row) sides.add_sides(f.pairs.template pair<W>(i, j), f.size_weight[j]);
+        const Mat<D> kept_sigma_i = (1.0 - sides.gain()) * sigma_i;
+        Vec<D> on_centre = Vec<D>::Zero();
+        for (NodeIndex j : row) {
+            const auto p = f.pairs.template pair<W>(i, j);
+            const Mat<D> sigma_j = cauchy_stress<G>(f.deviatoric_stress, f.pressure, f.viscous_pressure, j);
+            Vec<D> term = stress_difference_term(p, volume, f.size_weight[j], Vec<D>(normalisation * p.l), sigma_j, kept_sigma_i);
+            if (f.pairs.sliding(i, j)) term = along_pair<D>(f.pairs.sliding_normal(i, j, p.l), term);  // spec section 2
+            on_centre += term;
+            if (j >= real) {
+                for (int c = 0; c < D; ++c) f.force[c][j] -= term[c];
+            }
+        }
+        if constexpr (G::axisymmetric) {
+            const auto extra = cylindrical_divergence_terms(sigma_i(0, 0), sigma_i(0, 1),
+                                                            out_of_plane_stress(f.deviatoric_stress, f.pressure, f.viscous_pressure, i),
+                                                            volume, f.pairs.position[0][i]);
+            on_centre[0] += extra[0];
+            on_centre[1] += extra[1];
+        }
+        for (int c = 0; c < D; ++c) f.force[c][i] += on_centre[c];
+    };
+    for (std::size_t colour = 0; colour < plan.colours(); ++colour) {
+        tbb::parallel_for(
+            tbb::blocked_range<std::size_t>(plan.colour_offsets[colour], plan.colour_offsets[colour + 1], 1),
+            [&](const tbb::blocked_range<std::size_t>& groups) {
+                for (std::size_t g = groups.begin(); g != groups.end(); ++g) {
+                    for (NodeIndex i : plan.group(g)) centre(i);
+                }
+            });
+    }
+}
+
 template <class G, class W>
 void stress_power_impl(const CompressedRows& lists, const ForceFields<G::dim>& f,
                        const std::array<const double*, G::dim>& velocity, std::size_t n, double* power,
@@ -370,7 +431,14 @@ void compute_forces(const CompressedRows& lists, const ScatterPlan& plan, Weight
         using W = decltype(w);
         const bool full = f.full_normalisation;
         if (full && !f.alpha_shear[0]) throw InputError("compute_forces: the full normalisation needs alpha_shear");
-        if (bond && full) {
+        if (f.stress_difference) {
+            if (bond) throw InputError("compute_forces: the stress-difference form takes no bond viscosity");
+            if (full) {
+                stress_difference_impl<G, W, true>(lists, plan, f, node_count);
+            } else {
+                stress_difference_impl<G, W, false>(lists, plan, f, node_count);
+            }
+        } else if (bond && full) {
             forces_impl<G, W, true, true>(lists, plan, *bond, f, node_count);
         } else if (bond) {
             forces_impl<G, W, true, false>(lists, plan, *bond, f, node_count);

@@ -614,11 +614,18 @@ void check_plane(const Scene& scene, const PlaneSpec& p, std::size_t i) {
 }
 
 // Every key's range or word list, from the table of solver options (solver_options.hpp), so that
-// validation, the scene reader and study variants cannot disagree. No rule involves two solver
-// keys at once today; such a rule would follow the loop, written by hand.
+// validation, the scene reader and study variants cannot disagree; then the one rule that involves
+// several keys (the stress-difference form's), written by hand.
 void check_solver(const SolverOptions& s) {
     for (const SolverOption& option : solver_option_table()) {
         if (auto message = option_error(option, s)) fail(std::move(*message));
+    }
+    // The stress-difference form makes no pair forces, and bond viscosity is one.
+    if (s.force_form == ForceForm::StressDifference) {
+        if (s.viscosity == ViscosityKind::Bond) {
+            fail("solver.force_form = \"stress-difference\" takes viscosity = \"nodal\" or \"none\": bond viscosity is a "
+                 "pair force");
+        }
     }
 }
 

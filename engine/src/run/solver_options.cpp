@@ -69,6 +69,9 @@ std::vector<SolverOption> make_table() {
                  "halve the geometry factor normal to a free surface (the paper's section 2.5; per axis, or along the "
                  "neighbourhood's normal with the moment matrix)",
                  ""});
+    t.push_back({"force_form",
+                 choice_of(&S::force_form, {{"pairwise", ForceForm::Pairwise}, {"stress-difference", ForceForm::StressDifference}}),
+                 "stress forces: equal and opposite pair forces (Eq. 29) or each node's own divergence of the stress (Eq. 28)", ""});
     t.push_back({"viscosity",
                  choice_of(&S::viscosity, {{"none", ViscosityKind::None},
                                            {"nodal", ViscosityKind::Nodal},

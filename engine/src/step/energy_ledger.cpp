@@ -19,7 +19,9 @@ double* zeroed(std::vector<double>& v, std::size_t count) {
 }  // namespace
 
 EnergyLedger::EnergyLedger(const SolverOptions& solver)
-    : compatible_(solver.energy_update == EnergyUpdate::Compatible),
+    // The stress-difference form makes no pair forces, whose power the compatible update books:
+    // its internal energy follows the point update's own energy equation.
+    : compatible_(solver.energy_update == EnergyUpdate::Compatible && solver.force_form == ForceForm::Pairwise),
       bond_(solver.viscosity == ViscosityKind::Bond),
       hourglass_(solver.hourglass_coefficient > 0.0 || solver.hourglass_stiffness > 0.0),
       stiffness_(solver.hourglass_stiffness > 0.0),

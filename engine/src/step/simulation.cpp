@@ -377,6 +377,7 @@ void Simulation::Impl::forces() {
     f.pairs = neighbour_lists.with_kept_pairs(contact.fields(f.pairs, nodes));
     f.hoop_count = real;
     f.full_normalisation = scene.solver.normalisation == Normalisation::MomentMatrix;
+    f.stress_difference = scene.solver.force_form == ForceForm::StressDifference;
     BondViscosityParameters bond{scene.solver.viscosity_linear, scene.solver.viscosity_quadratic, scene.solver.bond_viscosity_eps0};
     const bool with_bond = scene.solver.viscosity == ViscosityKind::Bond;
     if (with_bond) {

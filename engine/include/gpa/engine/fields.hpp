@@ -170,6 +170,10 @@ struct ForceFields {
     double* bond_viscous_power = nullptr;  // per centre, optional: the power of its bond-viscous forces
     double* largest_bond_viscosity = nullptr;  // per centre, optional: its largest Q_ij (for the time step)
     std::size_t hoop_count = 0;            // centres [0, hoop_count) feel their hoop stress
+    // The stress-difference form (Eq. 28, kernels.hpp stress_difference_term) instead of pair
+    // forces: the real centres [0, hoop_count) gather their own forces; a ghost neighbour's term,
+    // reversed, is written on the ghost, where the planes read their reactions.
+    bool stress_difference = false;
 };
 
 // The normalisation N of node i (Eq. 14-15, 51-53: diag(alpha); spec section 7: M^-1 when the

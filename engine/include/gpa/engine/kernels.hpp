@@ -209,6 +209,50 @@ inline double hoop_force(double sigma_theta, double volume, double radius) {
     return -sigma_theta * volume / radius;
 }
 
+// The stress-difference form (the paper's Eq. 28; docs/surfaces.md): node i's force is V_i times
+// the divergence of the stress at i, estimated with the operator of its strain rates,
+//   F_i = V_i sum_j (R W_j / r) (sigma_j - kept sigma_i) N_i l,
+// one term per neighbour j, kept = 1 - g. g is the one-sidedness of i's neighbourhood
+// (one_sidedness): 0 inside a body, where the form is Eq. 28 and a uniform stress gives no force on
+// any neighbourhood; 1 at a free surface, where the missing side's zero stress completes it into the
+// sum form V_i sum_j (R W_j / r) sigma_j N_i l (a face node of a bar under uniform sigma then
+// feels -A sigma, the traction-free face; Eq. 28 alone would give it nothing).
+template <int D>
+inline Vec<D> stress_difference_term(const PairGeometry<D>& p, double volume_i, double size_weight_j, const Vec<D>& normalised_l,
+                                     const Mat<D>& sigma_j, const Mat<D>& kept_sigma_i) {
+    return (p.R * volume_i * size_weight_j * p.inv_r) * ((sigma_j - kept_sigma_i) * normalised_l);
+}
+
+// How one-sided a neighbourhood is: along its first moment's direction d (sum_j R W_j l), with p and
+// n the parts of sum_j R W_j (l . d)^2 from the neighbours ahead of and behind the node,
+// one_sided_gain(p, n, one_sided_threshold) / (p + n): 0 while the sides weigh within a factor of
+// three, 1 when one side is empty, linear in between (the surface correction's moment-matrix rule,
+// as a fraction of the moment).
+template <int D>
+struct OneSidedness {
+    Vec<D> first_moment = Vec<D>::Zero();
+    void add_first(const PairGeometry<D>& p, double size_weight_j) { first_moment += (p.R * size_weight_j) * p.l; }
+    double ahead = 0.0, behind = 0.0;
+    void add_sides(const PairGeometry<D>& p, double size_weight_j) {
+        const double length = first_moment.norm();
+        if (!(length > 0.0)) return;
+        const double along = p.l.dot(first_moment) / length;
+        (along > 0.0 ? ahead : behind) += p.R * size_weight_j * along * along;
+    }
+    double gain() const {
+        const double total = ahead + behind;
+        return total > 0.0 ? std::min(1.0, one_sided_gain(ahead, behind, one_sided_threshold) / total) : 1.0;
+    }
+};
+
+// The terms of the divergence of the stress in cylindrical coordinates that the section's gradient
+// does not give (axisymmetric geometry, Eq. 28's analogue of the hoop force): times V_i,
+// (sigma_xx - sigma_theta) / x along x and sigma_xz / x along z.
+inline std::array<double, 2> cylindrical_divergence_terms(double sigma_xx, double sigma_xz, double sigma_theta, double volume,
+                                                          double radius) {
+    return {volume * (sigma_xx - sigma_theta) / radius, volume * sigma_xz / radius};
+}
+
 // Eq. 38: mu_ij = h_ij (v_i - v_j).(x_i - x_j) / (r^2 + eps0 h_ij^2), with
 // (v_i - v_j).(x_i - x_j) = r (v_j - v_i).l.
 template <int D>

@@ -197,6 +197,12 @@ struct PrescribedVelocitySpec {
     double ramp = 0.0;                              // s
 };
 
+// Which form of the momentum equation gives the stress forces (spec section 5, docs/surfaces.md).
+enum class ForceForm {
+    Pairwise,          // Eq. 21-24 (the paper's Eq. 29): equal and opposite pair forces from each centre's stress
+    StressDifference,  // Eq. 28: F_i = V_i div(sigma) at i, gathered from sigma_j - sigma_i over i's row
+};
+
 // How the internal energy follows the stress (spec section 5, "[spec] Compatible energy").
 enum class EnergyUpdate {
     Compatible,  // the work of each node's stress forces at the mean velocities of the velocity update
@@ -233,6 +239,11 @@ struct SolverOptions {
     // The paper's correction at free surfaces and interfaces (its section 2.5): the geometry factor
     // normal to a one-sided neighbourhood halved (kernels.hpp, OneSidedMoments; docs/surfaces.md).
     bool surface_correction = false;
+    // Eq. 29 (pairwise) or Eq. 28 (stress differences; no equal and opposite forces, so momentum is
+    // not conserved; no bond viscosity; the internal energy follows the point update's energy
+    // equation whatever energy_update says, there being no pair forces whose power the compatible
+    // update could book; docs/surfaces.md).
+    ForceForm force_form = ForceForm::Pairwise;
     ViscosityKind viscosity = ViscosityKind::Nodal;
     double viscosity_linear = 0.2;     // C_L (Eq. 36, 37)
     double viscosity_quadratic = 4.0;  // C_Q
