@@ -242,7 +242,8 @@ struct SolverOptions {
     // Eq. 29 (pairwise) or Eq. 28 (stress differences; no equal and opposite forces, so momentum is
     // not conserved; no bond viscosity; the internal energy follows the point update's energy
     // equation whatever energy_update says, there being no pair forces whose power the compatible
-    // update could book; docs/surfaces.md).
+    // update could book). Unstable in every impact measured: a mode grows from the free surfaces
+    // within microseconds (docs/surfaces.md); for study, not for results.
     ForceForm force_form = ForceForm::Pairwise;
     ViscosityKind viscosity = ViscosityKind::Nodal;
     double viscosity_linear = 0.2;     // C_L (Eq. 36, 37)
