@@ -68,12 +68,11 @@ Across across_of(const GhostPlane& plane, int dim) {
 // radius x in axisymmetric geometry) in 2D, along the footprint's directions in the plane in 3D;
 // with its images across the symmetry planes in `mirrors` that stand on `plane` (normal to another
 // axis, at most one per axis), so that a half or quarter model is measured as the whole body.
-void add_to_extent(measure::Extent& e, const NodeStore& nodes, std::size_t i, const GhostPlane& plane, bool axisymmetric,
-                   double base, std::span<const GhostPlane> mirrors) {
+void add_to_extent(measure::Extent& e, const NodeStore& nodes, std::size_t i, const GhostPlane& plane, const Across& across,
+                   bool axisymmetric, double base, std::span<const GhostPlane> mirrors) {
     const int d = nodes.dim();
     const double height = plane.distance_of(nodes.position, i) - base;
     const double cell = measure::particle_cell_size(nodes.size_weight[i], d);
-    const Across across = across_of(plane, d);
     const auto add = [&](double along_first, double along_second) {
         if (d == 3) {
             measure::add_particle_3d(e, height, along_first, along_second, cell);
@@ -151,6 +150,7 @@ double Measures::advance_kinetic(double half_step_now) {
 NodeSums Measures::node_sums(const NodeStore& nodes, std::size_t real, const GhostPlane* plane, bool axisymmetric) const {
     const int d = nodes.dim();
     const std::vector<GhostPlane> mirrors = plane ? mirrors_on(*plane) : std::vector<GhostPlane>{};
+    const Across across = plane ? across_of(*plane, d) : Across{};
     return tbb::parallel_deterministic_reduce(
         tbb::blocked_range<std::size_t>(0, real, reduce_grain), NodeSums{},
         [&](const tbb::blocked_range<std::size_t>& r, NodeSums acc) {
@@ -167,7 +167,7 @@ NodeSums Measures::node_sums(const NodeStore& nodes, std::size_t real, const Gho
                 acc.viscous += m * nodes.viscous_work[i];
                 acc.variable += nodes.connectivity[i] == Connectivity::Variable;
                 acc.failed += nodes.failed[i] != 0;
-                if (plane) add_to_extent(acc.extent, nodes, i, *plane, axisymmetric, 0.0, mirrors);
+                if (plane) add_to_extent(acc.extent, nodes, i, *plane, across, axisymmetric, 0.0, mirrors);
             }
             return acc;
         },
@@ -177,10 +177,11 @@ NodeSums Measures::node_sums(const NodeStore& nodes, std::size_t real, const Gho
 measure::Extent Measures::particle_extent(const NodeStore& nodes, std::size_t real, const GhostPlane& plane, bool axisymmetric,
                                           double base) const {
     const std::vector<GhostPlane> mirrors = mirrors_on(plane);
+    const Across across = across_of(plane, nodes.dim());
     return tbb::parallel_deterministic_reduce(
         tbb::blocked_range<std::size_t>(0, real, reduce_grain), measure::Extent{},
         [&](const tbb::blocked_range<std::size_t>& r, measure::Extent acc) {
-            for (std::size_t i = r.begin(); i != r.end(); ++i) add_to_extent(acc, nodes, i, plane, axisymmetric, base, mirrors);
+            for (std::size_t i = r.begin(); i != r.end(); ++i) add_to_extent(acc, nodes, i, plane, across, axisymmetric, base, mirrors);
             return acc;
         },
         [](measure::Extent x, const measure::Extent& y) { return x += y; });
