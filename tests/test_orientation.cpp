@@ -110,18 +110,8 @@ TEST(Orientation, AnObliquePlaneReflectsPointsVectorsAndTensorsAsTheAlignedOnesD
 // long): in 3D a quarter model cut by the symmetry planes x = 0 and y = 0 with 5 nodes across the
 // radius, or in plane strain a whole section with 10 across.
 Scene copper_bar(GeometryKind geometry, Normalisation normalisation) {
-    Scene s = io::load_scene(std::string(GPA_SOURCE_DIR) + "/scenes/taylor-copper-190-3d.toml");
-    s.geometry = geometry;
-    auto& bar = s.bodies[0];
-    bar.length = 8e-3;
-    bar.spacing = bar.radius / 5.0;
-    if (geometry == GeometryKind::PlaneStrain) {
-        bar.shape = ShapeKind::Rectangle;
-        bar.origin = {-bar.radius, 0.0, 0.0};
-        bar.size = {2.0 * bar.radius, bar.length, 0.0};
-        bar.velocity = {0.0, -190.0, 0.0};
-        s.planes[0].axis = 1;
-    } else {
+    Scene s = testing::short_copper_bar(geometry, 5);
+    if (geometry == GeometryKind::ThreeD) {
         for (int axis : {0, 1}) {
             PlaneSpec p;
             p.name = axis == 0 ? "x-symmetry" : "y-symmetry";
@@ -131,8 +121,6 @@ Scene copper_bar(GeometryKind geometry, Normalisation normalisation) {
         }
     }
     s.solver.normalisation = normalisation;
-    s.stop.kinetic_energy_fraction = 0.0;
-    s.stop.end_time = 1.0;  // stepped by hand
     return s;
 }
 

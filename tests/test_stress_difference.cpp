@@ -31,14 +31,7 @@ struct Block {
     CompressedRows lists;
     bool full = false;
 
-    static testing::LatticeOptions unit_cells() {
-        testing::LatticeOptions o;  // 7 x 7 unit cells, nodes at 0.5 ... 6.5
-        o.cells = 7;
-        o.spacing = 1.0;
-        return o;
-    }
-
-    Block(double jitter, bool moment_matrix, std::uint64_t seed = 7) : nodes(testing::make_lattice(unit_cells())), full(moment_matrix) {
+    Block(double jitter, bool moment_matrix, std::uint64_t seed = 7) : nodes(testing::make_lattice(testing::unit_cells(7))), full(moment_matrix) {
         if (jitter > 0.0) testing::jitter(nodes, jitter, 1.0, seed);
         lists = find_neighbours(nodes, 1.0, nodes.size());
         auto f = gradient_fields<2>(nodes, 1.0);

@@ -27,16 +27,9 @@ namespace gpa {
 namespace {
 
 struct StressedBlock {
-    NodeStore nodes = testing::make_lattice(unit_cells());
+    NodeStore nodes = testing::make_lattice(testing::unit_cells(7));  // nodes at 0.5 ... 6.5
     CompressedRows lists;
     bool full = false;
-
-    static testing::LatticeOptions unit_cells() {
-        testing::LatticeOptions o;  // 7 x 7 unit cells, nodes at 0.5 ... 6.5
-        o.cells = 7;
-        o.spacing = 1.0;
-        return o;
-    }
 
     StressedBlock(bool corrected, bool moment_matrix) : full(moment_matrix) {
         lists = find_neighbours(nodes, 1.0, nodes.size());

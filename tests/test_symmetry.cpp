@@ -36,23 +36,7 @@ PlaneSpec symmetry_plane(int axis, double position = 0.0) {
 
 // A copper bar on a rigid anvil at 190 m/s with the solver of scenes/taylor-copper-190-3d.toml:
 // 3D, 6 nodes across the radius and 8 mm long; or its plane-strain section, 12 nodes across.
-Scene copper_bar(GeometryKind geometry) {
-    Scene s = io::load_scene(std::string(GPA_SOURCE_DIR) + "/scenes/taylor-copper-190-3d.toml");
-    s.geometry = geometry;
-    auto& bar = s.bodies[0];
-    bar.length = 8e-3;
-    bar.spacing = bar.radius / 6.0;
-    if (geometry == GeometryKind::PlaneStrain) {
-        bar.shape = ShapeKind::Rectangle;
-        bar.origin = {-bar.radius, 0.0, 0.0};
-        bar.size = {2.0 * bar.radius, bar.length, 0.0};
-        bar.velocity = {0.0, -190.0, 0.0};
-        s.planes[0].axis = 1;
-    }
-    s.stop.kinetic_energy_fraction = 0.0;
-    s.stop.end_time = 1.0;  // stepped by hand
-    return s;
-}
+Scene copper_bar(GeometryKind geometry) { return testing::short_copper_bar(geometry, 6); }
 
 // The same bar cut by the symmetry planes through its axis normal to `axes`: the body keeps its
 // shape and origin, the planes take its other share away.

@@ -24,6 +24,15 @@ struct LatticeOptions {
 
 NodeStore make_lattice(const LatticeOptions& o);
 
+// The paper's lattice of spec section 7: plane strain, `cells` x `cells` unit cells (nodes at 0.5,
+// 1.5, ...), variable connectivity.
+inline LatticeOptions unit_cells(int cells) {
+    LatticeOptions o;
+    o.cells = cells;
+    o.spacing = 1.0;
+    return o;
+}
+
 // Moves every node by a uniform random offset in [-amplitude, amplitude] * spacing per axis and
 // updates the axisymmetric size weights. Diameters keep their lattice value.
 void jitter(NodeStore& nodes, double amplitude, double spacing, std::uint64_t seed);

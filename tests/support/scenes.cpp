@@ -97,6 +97,24 @@ std::string node_bytes(const Simulation& sim) {
     return out.str();
 }
 
+Scene short_copper_bar(GeometryKind geometry, int radial_cells) {
+    Scene s = io::load_scene(std::string(GPA_SOURCE_DIR) + "/scenes/taylor-copper-190-3d.toml");
+    s.geometry = geometry;
+    auto& bar = s.bodies[0];
+    bar.length = 8e-3;
+    bar.spacing = bar.radius / radial_cells;
+    if (geometry == GeometryKind::PlaneStrain) {
+        bar.shape = ShapeKind::Rectangle;
+        bar.origin = {-bar.radius, 0.0, 0.0};
+        bar.size = {2.0 * bar.radius, bar.length, 0.0};
+        bar.velocity = {0.0, -190.0, 0.0};
+        s.planes[0].axis = 1;
+    }
+    s.stop.kinetic_energy_fraction = 0.0;
+    s.stop.end_time = 1.0;  // stepped by hand
+    return s;
+}
+
 Scene armco_cylinder(int radial_cells, double end_time) {
     Scene s;
     s.name = "Armco iron cylinder impact";

@@ -31,6 +31,11 @@ std::string node_bytes(const Simulation& sim);
 // "" when it reads.
 std::string scene_file_refusal(const std::string& text, const std::filesystem::path& file);
 
+// scenes/taylor-copper-190-3d.toml's copper bar at 190 m/s on its rigid anvil, shortened to 8 mm and
+// stepped by hand (no end condition met), at `radial_cells` nodes across the radius; or, in plane
+// strain, its section: a strip 2R wide. The run tests of symmetry planes and orientation use it.
+Scene short_copper_bar(GeometryKind geometry, int radial_cells);
+
 // The paper's Armco-iron cylinder (L0 15.2 mm, D0 10.2 mm, 305 m/s) at `radial_cells` across
 // the radius, nodal viscosity, no lift-off, with the given end time.
 Scene armco_cylinder(int radial_cells, double end_time);

@@ -206,16 +206,34 @@ void gradient_impl(const CompressedRows& lists, const GradientFields<G::dim>& f,
     if (const std::size_t bad = first_bad.load(); bad != no_node) report_gradient_failure<G, W>(lists, f, bad);
 }
 
+// Zeroes the forces of nodes [0, node_count).
+template <int D>
+void zero_forces(const ForceFields<D>& f, std::size_t node_count) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, node_count, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (int c = 0; c < D; ++c) std::fill(f.force[c] + r.begin(), f.force[c] + r.end(), 0.0);
+    });
+}
+
+// Calls centre(i) for every centre of `plan`, one colour after the other, the groups of a colour in
+// parallel: no two centres that run at once write the same node.
+template <class Centre>
+void for_each_coloured_centre(const ScatterPlan& plan, Centre&& centre) {
+    for (std::size_t colour = 0; colour < plan.colours(); ++colour) {
+        tbb::parallel_for(
+            tbb::blocked_range<std::size_t>(plan.colour_offsets[colour], plan.colour_offsets[colour + 1], 1),
+            [&](const tbb::blocked_range<std::size_t>& groups) {
+                for (std::size_t g = groups.begin(); g != groups.end(); ++g) {
+                    for (NodeIndex i : plan.group(g)) centre(i);
+                }
+            });
+    }
+}
+
 template <class G, class W, bool with_bond_viscosity, bool full>
 void forces_impl(const CompressedRows& lists, const ScatterPlan& plan, const BondViscosityParameters& bond,
                  const ForceFields<G::dim>& f, std::size_t node_count) {
     constexpr int D = G::dim;
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, node_count, 4096),
-                      [&](const tbb::blocked_range<std::size_t>& r) {
-                          for (int c = 0; c < D; ++c) {
-                              std::fill(f.force[c] + r.begin(), f.force[c] + r.end(), 0.0);
-                          }
-                      });
+    zero_forces<D>(f, node_count);
 
     const auto centre = [&](std::size_t i) {
         const Mat<D> sigma = cauchy_stress<G>(f.deviatoric_stress, f.pressure, f.viscous_pressure, i);
@@ -278,15 +296,7 @@ void forces_impl(const CompressedRows& lists, const ScatterPlan& plan, const Bon
         }
     };
 
-    for (std::size_t colour = 0; colour < plan.colours(); ++colour) {
-        tbb::parallel_for(
-            tbb::blocked_range<std::size_t>(plan.colour_offsets[colour], plan.colour_offsets[colour + 1], 1),
-            [&](const tbb::blocked_range<std::size_t>& groups) {
-                for (std::size_t g = groups.begin(); g != groups.end(); ++g) {
-                    for (NodeIndex i : plan.group(g)) centre(i);
-                }
-            });
-    }
+    for_each_coloured_centre(plan, centre);
 }
 
 // The stress-difference form (Eq. 28): each real centre gathers its own force over its row
@@ -297,12 +307,7 @@ template <class G, class W, bool full>
 void stress_difference_impl(const CompressedRows& lists, const ScatterPlan& plan, const ForceFields<G::dim>& f,
                             std::size_t node_count) {
     constexpr int D = G::dim;
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, node_count, 4096),
-                      [&](const tbb::blocked_range<std::size_t>& r) {
-                          for (int c = 0; c < D; ++c) {
-                              std::fill(f.force[c] + r.begin(), f.force[c] + r.end(), 0.0);
-                          }
-                      });
+    zero_forces<D>(f, node_count);
     const std::size_t real = f.hoop_count;
     const auto centre = [&](std::size_t i) {
         if (i >= real) return;
@@ -339,15 +344,7 @@ void stress_difference_impl(const CompressedRows& lists, const ScatterPlan& plan
         }
         for (int c = 0; c < D; ++c) f.force[c][i] += on_centre[c];
     };
-    for (std::size_t colour = 0; colour < plan.colours(); ++colour) {
-        tbb::parallel_for(
-            tbb::blocked_range<std::size_t>(plan.colour_offsets[colour], plan.colour_offsets[colour + 1], 1),
-            [&](const tbb::blocked_range<std::size_t>& groups) {
-                for (std::size_t g = groups.begin(); g != groups.end(); ++g) {
-                    for (NodeIndex i : plan.group(g)) centre(i);
-                }
-            });
-    }
+    for_each_coloured_centre(plan, centre);
 }
 
 template <class G, class W>

@@ -277,7 +277,10 @@ std::string solver_preset_list(bool quoted) {
 }
 
 void apply_solver_preset(const SolverPreset& preset, SolverOptions& s) {
-    for (const auto& [key, value] : preset.settings) {
+    for (const auto& setting : preset.settings) {
+        // Plain names, not a structured binding: clang 14 (the sanitizer build) refuses lambdas
+        // that capture one.
+        const std::string_view key = setting.first, value = setting.second;
         const SolverOption* option = find_solver_option(key);
         if (!option) throw std::logic_error(fmt::format("preset {}: {} is no solver option", preset.name, key));
         std::visit(
