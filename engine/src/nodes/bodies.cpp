@@ -30,6 +30,14 @@ std::pair<std::int64_t, double> fit(double extent, double spacing, const std::st
     return {static_cast<std::int64_t>(cells), extent / cells};
 }
 
+// A count of lattice cells the caller computed (extent / spacing, rounded its way), refused beyond
+// fit's 1e7 as fit refuses it: a size many orders beyond any impact body (a unit slip) is caught here,
+// where the checks that fill lattices (overlaps, regions) meet it before the memory estimate does.
+std::int64_t checked_cells(double cells, const std::string& body, const char* what) {
+    if (!(cells <= 1e7)) throw InputError(fmt::format("body \"{}\": {} needs {} lattice cells", body, what, cells));
+    return static_cast<std::int64_t>(cells);
+}
+
 }  // namespace
 
 LatticeBlock body_lattice(const Scene& scene, std::size_t index) {
@@ -91,7 +99,7 @@ LatticeBlock body_lattice(const Scene& scene, std::size_t index) {
             case ShapeKind::Cylinder:
             case ShapeKind::Plate: {
                 const auto [nz, s] = fit(b.length, dx, b.name, "length");
-                const std::int64_t half = static_cast<std::int64_t>(std::ceil(b.radius / s - 1e-9));
+                const std::int64_t half = checked_cells(std::ceil(b.radius / s - 1e-9), b.name, "radius");
                 const double r = b.radius, cx = o[0], cy = o[1];
                 block.origin = {cx, cy, o[2]};
                 block.spacing = {s, s, s};
@@ -108,8 +116,8 @@ LatticeBlock body_lattice(const Scene& scene, std::size_t index) {
                 const auto [nz, s] = fit(b.size[2], dx, b.name, "size z");
                 block.origin = o;
                 block.spacing = {s, s, s};
-                block.last = {std::max<std::int64_t>(1, std::llround(b.size[0] / s)),
-                              std::max<std::int64_t>(1, std::llround(b.size[1] / s)), nz};
+                block.last = {std::max<std::int64_t>(1, checked_cells(std::round(b.size[0] / s), b.name, "size x")),
+                              std::max<std::int64_t>(1, checked_cells(std::round(b.size[1] / s), b.name, "size y")), nz};
                 break;
             }
             case ShapeKind::Sphere: {
