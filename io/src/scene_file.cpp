@@ -39,7 +39,7 @@ const std::vector<std::string_view> scene_keys{
 const std::vector<std::string_view> body_keys{
     "name",    "shape",     "material", "origin",         "size",         "radius",            "diameter",
     "length",  "spacing",   "spacing_z", "velocity",      "initial_stress", "connectivity",    "lattice_neighbours",
-    "discretisation", "inner_radius", "nose", "file", "unit", "rotation",
+    "discretisation", "inner_radius", "nose", "file", "unit", "rotation", "fill",
 };
 const std::vector<std::string_view> plane_keys{"name", "kind", "axis", "position", "normal", "point", "side", "lift_off",
                                                "friction", "static_friction"};
@@ -287,7 +287,7 @@ BodySpec read_body(const Reporter& reporter, const toml::table& table, std::size
                                        : "does not apply to imported nodes (their file gives their positions and sizes)");
             }
         }
-        for (const std::string_view key : {"spacing", "spacing_z", "lattice_neighbours"}) {
+        for (const std::string_view key : {"spacing", "spacing_z", "lattice_neighbours", "fill"}) {
             if (!surface && r.has(key)) {
                 r.fail_at(key, "does not apply to imported nodes: they have no lattice (their file gives each node's size)");
             }
@@ -413,6 +413,7 @@ BodySpec read_body(const Reporter& reporter, const toml::table& table, std::size
     }
     b.connectivity = r.choice<ConnectivityMode>("connectivity", connectivity_words);
     if (const auto n = r.whole_number("lattice_neighbours", 0, 26)) b.lattice_neighbours = static_cast<int>(*n);
+    b.fill = r.choice<CellFill>("fill", {{"centres", CellFill::Centres}, {"trimmed", CellFill::Trimmed}});
     if (const auto rotation = read_rotation(r, geometry, "a body in an axisymmetric scene")) {
         if (b.discretisation == Discretisation::Elements) {
             r.fail_at("rotation", "applies to particle bodies only: an element body's mesh follows the scene's axes");

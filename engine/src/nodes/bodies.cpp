@@ -173,6 +173,7 @@ LatticeBlock body_lattice(const Scene& scene, std::size_t index) {
     // along a lattice axis.
     block.rotation = b.rotation;
     block.pivot = b.origin;
+    block.trim = cell_fill(b, scene.geometry) == CellFill::Trimmed;
     for (std::size_t k = 0; k < scene.planes.size(); ++k) {
         if (!symmetry_plane_cuts(scene, index, k)) continue;
         const PlaneSpec& given = scene.planes[k];

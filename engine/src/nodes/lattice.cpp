@@ -58,6 +58,124 @@ struct CellHash {
     }
 };
 
+// The part of the cell centred at `centre` that block.inside covers (LatticeBlock::trim).
+struct CellShare {
+    double fraction = 0.0;
+    std::array<double, 3> centroid{0, 0, 0};
+};
+
+CellShare trimmed_share(const LatticeBlock& block, const std::array<double, 3>& centre, int dim) {
+    CellShare out;
+    // Corners and centre: all inside, the cell is whole (its node at its centre, as untrimmed).
+    bool all = block.inside(centre), any = all;
+    for (int corner = 0; corner < (1 << dim); ++corner) {
+        std::array<double, 3> q = centre;
+        for (int c = 0; c < dim; ++c) q[c] += ((corner >> c) & 1 ? 0.5 : -0.5) * block.spacing[c];
+        const bool in = block.inside(q);
+        all = all && in;
+        any = any || in;
+    }
+    if (all) {
+        out.fraction = 1.0;
+        out.centroid = centre;
+        return out;
+    }
+    if (!any) return out;
+    // Midpoints of m^D equal sub-cells, offsets (2a + 1 - m) / (2m) of the spacing from the
+    // centre: the sub-cells a and m - 1 - a lie exactly opposite, so mirror cells get mirror nodes.
+    // The offsets are summed as the integers 2a + 1 - m, so that the centroid's offset is exact
+    // in sign and a mirror cell's node is the mirror of this one's bit for bit.
+    const int m = block.trim_samples;
+    std::array<std::int64_t, 3> sum{0, 0, 0};
+    std::int64_t count = 0, total = 0;
+    const int mz = dim == 3 ? m : 1;
+    for (int az = 0; az < mz; ++az) {
+        for (int ay = 0; ay < m; ++ay) {
+            for (int ax = 0; ax < m; ++ax) {
+                const std::array<int, 3> a{ax, ay, az};
+                std::array<double, 3> q = centre;
+                for (int c = 0; c < dim; ++c) {
+                    q[c] += static_cast<double>(2 * a[c] + 1 - m) / static_cast<double>(2 * m) * block.spacing[c];
+                }
+                ++total;
+                if (!block.inside(q)) continue;
+                ++count;
+                for (int c = 0; c < dim; ++c) sum[c] += 2 * a[c] + 1 - m;
+            }
+        }
+    }
+    if (count == 0) return out;
+    out.fraction = static_cast<double>(count) / static_cast<double>(total);
+    out.centroid = centre;
+    for (int c = 0; c < dim; ++c) {
+        out.centroid[c] += static_cast<double>(sum[c]) / static_cast<double>(2 * m * count) * block.spacing[c];
+    }
+    return out;
+}
+
+// Merges every part below block.smallest_share into its fullest face neighbour at least that full
+// (LatticeBlock::trim; ties below), in place: the sliver's entries go, the neighbour's share grows by the
+// sliver's and its node moves to the centroid of both (weighted by share). A sliver with no such
+// neighbour is dropped. The choice reads the shares as sampled, so merges do not chain.
+void merge_slivers(const LatticeBlock& block, int dim, std::vector<std::array<std::int64_t, 3>>& cells,
+                   std::vector<std::array<double, 3>>& points, std::vector<double>& shares) {
+    std::unordered_map<std::array<std::int64_t, 3>, std::size_t, CellHash> index_of;
+    index_of.reserve(cells.size());
+    for (std::size_t k = 0; k < cells.size(); ++k) index_of.emplace(cells[k], k);
+    const std::vector<double> sampled = shares;
+    std::vector<std::array<double, 3>> moment(points.size());  // share-weighted sums of node positions
+    for (std::size_t k = 0; k < points.size(); ++k) {
+        for (int c = 0; c < 3; ++c) moment[k][c] = sampled[k] * points[k][c];
+    }
+    std::vector<bool> gone(cells.size(), false);
+    for (std::size_t k = 0; k < cells.size(); ++k) {
+        if (sampled[k] >= block.smallest_share) continue;
+        gone[k] = true;
+        // The fullest neighbour; at a tie the one along the lower axis, then the one nearer the
+        // block's middle along it: a choice that mirrors with the cells (a mirror-symmetric shape
+        // merges its slivers symmetrically).
+        std::size_t best = cells.size();
+        int best_axis = 0;
+        double best_off_middle = 0.0;
+        for (int c = 0; c < dim; ++c) {
+            const auto a = static_cast<std::size_t>(c);
+            const double middle = 0.5 * static_cast<double>(block.first[a] + block.last[a] - 1);
+            for (const int step : {-1, 1}) {
+                auto nb = cells[k];
+                nb[a] += step;
+                const auto it = index_of.find(nb);
+                if (it == index_of.end() || sampled[it->second] < block.smallest_share) continue;
+                const double off_middle = std::abs(static_cast<double>(nb[a]) - middle);
+                const bool better = best == cells.size() || sampled[it->second] > sampled[best] ||
+                                    (sampled[it->second] == sampled[best] &&
+                                     (c < best_axis || (c == best_axis && off_middle < best_off_middle)));
+                if (better) {
+                    best = it->second;
+                    best_axis = c;
+                    best_off_middle = off_middle;
+                }
+            }
+        }
+        if (best == cells.size()) continue;
+        shares[best] += sampled[k];
+        for (int c = 0; c < 3; ++c) moment[best][c] += moment[k][c];
+    }
+    std::size_t kept = 0;
+    for (std::size_t k = 0; k < cells.size(); ++k) {
+        if (gone[k]) continue;
+        cells[kept] = cells[k];
+        shares[kept] = shares[k];
+        if (shares[k] != sampled[k]) {
+            for (int c = 0; c < 3; ++c) points[k][c] = moment[k][c] / shares[k];
+        }
+        points[kept] = points[k];
+        ++kept;
+    }
+    cells.resize(kept);
+    points.resize(kept);
+    shares.resize(kept);
+}
+
 }  // namespace
 
 std::vector<MirrorPlane> lattice_mirror_planes(const LatticeBlock& block, const std::vector<MirrorPlane>& planes, int dim) {
@@ -123,7 +241,14 @@ std::size_t fill_lattice(NodeStore& nodes, const LatticeBlock& block) {
 
     const std::size_t first_new = nodes.size();
     std::vector<std::array<std::int64_t, 3>> cells;
-    std::vector<std::array<double, 3>> centres;
+    std::vector<std::array<double, 3>> centres;  // the cells' centres (the lattice's geometry)
+    std::vector<std::array<double, 3>> points;   // the nodes: the centres, or trimmed parts' centroids
+    std::vector<double> shares;                  // each node's share of its cell (1: whole)
+    const bool trim = block.trim && static_cast<bool>(block.inside);
+    if (trim && (block.trim_samples < 2 || block.trim_samples > 64 || !(block.smallest_share > 0.0 && block.smallest_share <= 1.0))) {
+        throw InputError(fmt::format("trimmed lattice: {} samples per axis (2 to 64) and smallest share {} (in (0, 1])",
+                                     block.trim_samples, block.smallest_share));
+    }
     const std::int64_t zlast = dim == 3 ? block.last[2] : block.first[2] + 1;
     for (std::int64_t kz = block.first[2]; kz < zlast; ++kz) {
         for (std::int64_t ky = block.first[1]; ky < block.last[1]; ++ky) {
@@ -133,12 +258,24 @@ std::size_t fill_lattice(NodeStore& nodes, const LatticeBlock& block) {
                 for (int c = 0; c < dim; ++c) {
                     p[c] = block.origin[c] + (static_cast<double>(k[c]) + 0.5) * block.spacing[c];
                 }
-                if (block.inside && !block.inside(p)) continue;
+                if (!trim) {
+                    if (block.inside && !block.inside(p)) continue;
+                    cells.push_back(k);
+                    centres.push_back(p);
+                    points.push_back(p);
+                    shares.push_back(1.0);
+                    continue;
+                }
+                const auto share = trimmed_share(block, p, dim);
+                if (!(share.fraction > 0.0)) continue;
                 cells.push_back(k);
                 centres.push_back(p);
+                points.push_back(share.centroid);
+                shares.push_back(share.fraction);
             }
         }
     }
+    if (trim) merge_slivers(block, dim, cells, points, shares);
 
     const std::size_t added = cells.size();
     nodes.resize(first_new + added);
@@ -146,26 +283,30 @@ std::size_t fill_lattice(NodeStore& nodes, const LatticeBlock& block) {
     index_of.reserve(added);
     for (std::size_t k = 0; k < added; ++k) {
         const std::size_t i = first_new + k;
-        const auto p = block.place(centres[k]);
+        const auto p = block.place(points[k]);
         for (int c = 0; c < dim; ++c) {
             nodes.position[c][i] = p[c];
             nodes.initial_position[c][i] = p[c];
             nodes.velocity[c][i] = block.velocity[c];
         }
-        double v0 = cell_volume;
+        const bool whole = shares[k] == 1.0;
+        double v0 = whole ? cell_volume : shares[k] * cell_volume;
         if (nodes.geometry() == GeometryKind::Axisymmetric) {
             if (!(p[0] > 0.0)) {
                 throw InputError(fmt::format(
-                    "axisymmetric lattice cell ({}, {}) has its centre at x = {} m; nodes must have x > 0",
+                    "axisymmetric lattice cell ({}, {}) has its node at x = {} m; nodes must have x > 0",
                     cells[k][0], cells[k][1], p[0]));
             }
-            v0 = 2.0 * std::numbers::pi * p[0] * cell_area;  // a ring of cross-section dx dz
+            // A ring of cross-section dx dz (Pappus: 2 pi times the section's centroid radius).
+            v0 = 2.0 * std::numbers::pi * p[0] * (whole ? cell_area : shares[k] * cell_area);
         }
         nodes.initial_volume[i] = v0;
         nodes.volume[i] = v0;
         nodes.mass[i] = block.density * v0;
-        nodes.initial_diameter[i] = d0;
-        nodes.diameter[i] = d0;
+        // A trimmed node's d0 is the side of the cube (square) of its size.
+        const double node_d0 = whole ? d0 : d0 * (dim == 3 ? std::cbrt(shares[k]) : std::sqrt(shares[k]));
+        nodes.initial_diameter[i] = node_d0;
+        nodes.diameter[i] = node_d0;
         if (nodes.dim() == 3) {
             for (int c = 0; c < 6; ++c) nodes.left_cauchy_green[c][i] = c < 3 ? 1.0 : 0.0;
         }

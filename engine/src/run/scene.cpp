@@ -364,6 +364,12 @@ void check_body(const Scene& scene, const BodySpec& b, std::size_t i) {
         // (A scene reader checks the scene before it reads the surface files: body_lattice refuses a
         // body whose surface is still missing when its nodes are made.)
         if (b.surface) check_surface(b.surface->triangles(), fmt::format("{}.file \"{}\"", label, b.surface_file));
+        if (b.fill == CellFill::Trimmed) {
+            fail(fmt::format("{}.fill = \"trimmed\" applies to cylinders, plates, spheres, rectangles and boxes; a surface's "
+                             "cells are filled by their centres (sampling each boundary cell against the triangles would "
+                             "cost a point-in-surface test per sample)",
+                             label));
+        }
     } else if (b.shape == ShapeKind::Nodes) {
         // Imported nodes (node_set.hpp): their own sizes, no lattice.
         if (b.node_set) {
@@ -385,6 +391,9 @@ void check_body(const Scene& scene, const BodySpec& b, std::size_t i) {
         }
         if (b.lattice_neighbours != 0) {
             fail(fmt::format("{}.lattice_neighbours: imported nodes have no lattice (their connectivity is variable)", label));
+        }
+        if (b.fill) {
+            fail(fmt::format("{}.fill: imported nodes have no lattice to fill (their file gives each node)", label));
         }
         if (b.spacing != 0.0 || b.spacing_z != 0.0) {
             fail(fmt::format("{}.spacing: imported nodes bring their own sizes (their volumes or areas); give no spacing", label));
@@ -497,6 +506,7 @@ void check_body(const Scene& scene, const BodySpec& b, std::size_t i) {
             fail(fmt::format("{}.lattice_neighbours applies to particle bodies only (this body is discretised by elements)",
                              label));
         }
+        if (b.fill) fail(fmt::format("{}.fill applies to particle bodies only (this body is discretised by elements)", label));
     }
     if (b.lattice_neighbours != 0) {
         const int n = b.lattice_neighbours;
@@ -1015,6 +1025,14 @@ std::vector<std::string> scene_warnings(const Scene& scene) {
                                   "time sound takes across a node: check its unit (s, ms, us)", scene.stop.end_time));
     }
     return out;
+}
+
+std::string_view name_of(CellFill f) { return f == CellFill::Trimmed ? "trimmed" : "centres"; }
+
+CellFill cell_fill(const BodySpec& b, GeometryKind g) {
+    if (b.fill) return *b.fill;
+    const bool round = b.shape == ShapeKind::Cylinder || b.shape == ShapeKind::Plate || b.shape == ShapeKind::Sphere;
+    return g == GeometryKind::ThreeD && round ? CellFill::Trimmed : CellFill::Centres;
 }
 
 double nominal_spacing(const BodySpec& b) {

@@ -51,6 +51,22 @@ struct LatticeBlock {
     double stencil_reach = 0.0;
     // Keeps the cells whose centre it accepts (x, z) or (x, y, z); empty: keep all.
     std::function<bool(const std::array<double, 3>&)> inside;
+    // Trimmed cells (BodySpec::fill, CellFill::Trimmed; docs/scene-format.md): every cell the shape
+    // `inside` covers in part becomes a node of that part, instead of the cells whose centre it
+    // covers. A cell whose corners and centre all lie inside is whole (its node at its centre, as
+    // without trimming); any other is sampled at trim_samples^D points (midpoints of equal
+    // sub-cells, placed symmetrically about the centre so that a mirror-symmetric shape gets
+    // mirror-symmetric nodes). Its share of the cell is the fraction inside, its node the mean of
+    // the points inside, its size the share of the cell's (volume; in 2D the section, a ring's
+    // volume 2 pi x A about the node's radius) and its d0 the side of a cube (square) of that size.
+    // A part below smallest_share of a cell (a sliver) is merged into the face neighbour, among
+    // the cells at least that full, with the largest share (the first along x, y, z at a tie):
+    // the neighbour's node moves to the centroid of both parts, so no mass is lost and no node is
+    // a sliver (whose small d0 would shorten the stable step). A shape thinner than a cell that
+    // misses every corner and the centre is not seen.
+    bool trim = false;
+    int trim_samples = 10;
+    double smallest_share = 0.25;
     // Planes with ghosts, in the block's own axes (axis-aligned): a stencil neighbour that falls
     // behind them and whose mirror image is a cell of this block becomes a mirrored lattice
     // neighbour (NodeStore::fixed_mirrors).

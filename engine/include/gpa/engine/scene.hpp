@@ -69,6 +69,14 @@ enum class Discretisation { Particles, Elements };
 
 std::string_view name_of(Discretisation d);
 
+// How a lattice fills a shape's boundary cells (docs/scene-format.md, `fill`): `Centres` keeps the
+// cells whose centre lies inside (the staircase of the paper's lattices); `Trimmed` makes every
+// cell the shape covers in part a node of that part (its centroid, its volume), slivers merged
+// into a neighbour (LatticeBlock::trim): the body's outline and mass are the shape's.
+enum class CellFill { Centres, Trimmed };
+
+std::string_view name_of(CellFill f);
+
 // The shaped end of a cylinder: a projectile's nose (Borvik et al. fired blunt, hemispherical and
 // conical ones; tangent ogives are the usual long-rod and bullet shape). The nose is part of the
 // cylinder's `length`, at its lower z end (end = -1, a projectile flying towards -z) or its upper.
@@ -135,7 +143,13 @@ struct BodySpec {
     Rotation rotation = identity_rotation;
     std::optional<ConnectivityMode> connectivity;  // overrides SolverOptions::connectivity (particles only)
     int lattice_neighbours = 0;                    // fixed lists: 4/8 (2D), 6/18/26 (3D); 0 = 8 or 26 (particles only)
+    std::optional<CellFill> fill;                  // lattice bodies of particles; unset: cell_fill's default
 };
+
+// The fill of body b's lattice in a scene of geometry g: b.fill when given; otherwise `Trimmed` for
+// a 3D cylinder, plate or sphere (whose cubic staircase measurably widens a Taylor bar's footprint,
+// docs/validation.md) and `Centres` for the rest.
+CellFill cell_fill(const BodySpec& b, GeometryKind g);
 
 // The radius of cylinder (or plate) b's cross-section at `height` above its base (z minus the
 // origin's z): b.radius along the shank, the nose's profile (NoseSpec) over the nose, 0 outside
