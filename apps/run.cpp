@@ -182,8 +182,9 @@ int check_scene(const fs::path& file, const MemoryLimit& memory) {
         // Every axis's spacing: x, z in 2D; x, y, z in 3D.
         std::vector<std::string> spacing;
         for (int c = 0; c < dimension_of(scene.geometry); ++c) spacing.push_back(fmt::format("{:.4g}", block.spacing[c] * 1e3));
-        fmt::print("  body \"{}\": {}, {} nodes{}, lattice spacing {} mm\n", scene.bodies[b].name, scene.bodies[b].material, count,
-                   elements, fmt::join(spacing, " x "));
+        const bool trimmed = elements.empty() && block.trim;
+        fmt::print("  body \"{}\": {}, {} nodes{}, lattice spacing {} mm{}\n", scene.bodies[b].name, scene.bodies[b].material, count,
+                   elements, fmt::join(spacing, " x "), trimmed ? ", cells trimmed to the surface" : "");
     }
     // A material derived with `base`: what it changes, constant by constant.
     for (const auto& material : scene.materials) {
