@@ -141,6 +141,23 @@ TEST(SymmetryCut, HalfAPlaneStrainBarIsTheWholeBarsHalfToRoundOffUnderEitherConn
     }
 }
 
+// A trimmed 3D bar (the default fill) under fixed connectivity: its fixed lists continue across
+// the planes from the cells' centres, which must stay those of the nodes' cells where slivers were
+// merged away (fill_lattice).
+TEST(SymmetryCut, AQuarterOfAFixedTrimmedThreeDBarIsTheWholeBarsQuadrantToRoundOff) {
+    Scene whole = copper_bar(GeometryKind::ThreeD);
+    whole.solver.connectivity = ConnectivityMode::Fixed;
+    ASSERT_EQ(cell_fill(whole.bodies[0], whole.geometry), CellFill::Trimmed);
+    const Scene quarter = cut(whole, {0, 1});
+    Simulation a(quarter, 2), b(whole, 2);
+    // Slivers were merged: some nodes hold more than a cell.
+    const double cell = std::pow(whole.bodies[0].spacing, 3);
+    std::size_t merged = 0;
+    for (std::size_t i = 0; i < b.real_count(); ++i) merged += b.nodes().initial_volume[i] > cell * (1.0 + 1e-9);
+    ASSERT_GT(merged, 0u);
+    expect_same_run(a, b, 4, 100);
+}
+
 TEST(SymmetryCut, TheQuarterFillIsTheWholeFillsQuadrant) {
     const Scene whole = copper_bar(GeometryKind::ThreeD);
     const Scene quarter = cut(whole, {0, 1});

@@ -114,11 +114,13 @@ CellShare trimmed_share(const LatticeBlock& block, const std::array<double, 3>& 
 }
 
 // Merges every part below block.smallest_share into its fullest face neighbour at least that full
-// (LatticeBlock::trim; ties below), in place: the sliver's entries go, the neighbour's share grows by the
-// sliver's and its node moves to the centroid of both (weighted by share). A sliver with no such
-// neighbour is dropped. The choice reads the shares as sampled, so merges do not chain.
+// (LatticeBlock::trim; ties below), in place: the sliver's entries (cell, centre, node, share) go,
+// the neighbour's share grows by the sliver's and its node moves to the centroid of both (weighted
+// by share). A sliver with no such neighbour is dropped. The choice reads the shares as sampled, so
+// merges do not chain.
 void merge_slivers(const LatticeBlock& block, int dim, std::vector<std::array<std::int64_t, 3>>& cells,
-                   std::vector<std::array<double, 3>>& points, std::vector<double>& shares) {
+                   std::vector<std::array<double, 3>>& centres, std::vector<std::array<double, 3>>& points,
+                   std::vector<double>& shares) {
     std::unordered_map<std::array<std::int64_t, 3>, std::size_t, CellHash> index_of;
     index_of.reserve(cells.size());
     for (std::size_t k = 0; k < cells.size(); ++k) index_of.emplace(cells[k], k);
@@ -164,6 +166,7 @@ void merge_slivers(const LatticeBlock& block, int dim, std::vector<std::array<st
     for (std::size_t k = 0; k < cells.size(); ++k) {
         if (gone[k]) continue;
         cells[kept] = cells[k];
+        centres[kept] = centres[k];
         shares[kept] = shares[k];
         if (shares[k] != sampled[k]) {
             for (int c = 0; c < 3; ++c) points[k][c] = moment[k][c] / shares[k];
@@ -172,6 +175,7 @@ void merge_slivers(const LatticeBlock& block, int dim, std::vector<std::array<st
         ++kept;
     }
     cells.resize(kept);
+    centres.resize(kept);
     points.resize(kept);
     shares.resize(kept);
 }
@@ -275,7 +279,7 @@ std::size_t fill_lattice(NodeStore& nodes, const LatticeBlock& block) {
             }
         }
     }
-    if (trim) merge_slivers(block, dim, cells, points, shares);
+    if (trim) merge_slivers(block, dim, cells, centres, points, shares);
 
     const std::size_t added = cells.size();
     nodes.resize(first_new + added);
