@@ -1027,8 +1027,6 @@ std::vector<std::string> scene_warnings(const Scene& scene) {
     return out;
 }
 
-std::string_view name_of(CellFill f) { return f == CellFill::Trimmed ? "trimmed" : "centres"; }
-
 CellFill cell_fill(const BodySpec& b, GeometryKind g) {
     if (b.fill) return *b.fill;
     const bool round = b.shape == ShapeKind::Cylinder || b.shape == ShapeKind::Plate || b.shape == ShapeKind::Sphere;

@@ -75,8 +75,6 @@ std::string_view name_of(Discretisation d);
 // into a neighbour (LatticeBlock::trim): the body's outline and mass are the shape's.
 enum class CellFill { Centres, Trimmed };
 
-std::string_view name_of(CellFill f);
-
 // The shaped end of a cylinder: a projectile's nose (Borvik et al. fired blunt, hemispherical and
 // conical ones; tangent ogives are the usual long-rod and bullet shape). The nose is part of the
 // cylinder's `length`, at its lower z end (end = -1, a projectile flying towards -z) or its upper.
