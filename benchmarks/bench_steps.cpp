@@ -55,6 +55,7 @@ using gpa::bench::parse_list;
 // The bar of scenes/taylor-copper-190.toml in the geometry and connectivity of `name`, with a
 // spacing that gives about `nodes` nodes.
 double skin_option = -1.0;  // --skin: SolverOptions::neighbour_skin (< 0: the default)
+bool hourglass_all = false;  // --hourglass-all: the hourglass damping on every node
 
 gpa::Scene make_case(const std::string& name, double nodes) {
     gpa::Scene scene = gpa::io::load_scene(std::filesystem::path(GPA_SOURCE_DIR) / "scenes/taylor-copper-190.toml");
@@ -77,6 +78,7 @@ gpa::Scene make_case(const std::string& name, double nodes) {
     scene.solver.connectivity = name.find("fixed") != std::string::npos ? gpa::ConnectivityMode::Fixed
                                                                          : gpa::ConnectivityMode::Variable;
     if (skin_option >= 0.0) scene.solver.neighbour_skin = skin_option;
+    if (hourglass_all) scene.solver.hourglass_nodes = gpa::HourglassNodes::All;
     scene.stop = {};
     scene.stop.max_steps = 1u << 30;
     return scene;
@@ -177,6 +179,7 @@ int main(int argc, char** argv) {
     app.add_option("--repeat", repeat, "rounds (medians are reported)")->check(CLI::Range(1, 1000));
     app.add_option("--skin", skin_option, "neighbour skin, a fraction of the interaction radius (default: the solver's)")
         ->check(CLI::Range(0.0, 1.0));
+    app.add_flag("--hourglass-all", hourglass_all, "the hourglass damping on every node (solver.hourglass_nodes = \"all\")");
     app.add_flag("--memory", memory, "peak resident memory per node of a run with a search, a reorder and a snapshot");
     app.add_flag("--bandwidth", bandwidth, "triad memory bandwidth on each thread count");
     app.add_flag("--quick", quick, "CI: 2d-variable at 1e5 nodes, 1 and 2 threads, 10 steps x 3");

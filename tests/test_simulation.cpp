@@ -1,6 +1,7 @@
 // Whole runs of the engine: energy and momentum balances, an elastic bar against a rigid plane,
 // smoothing, thread independence, and the phases a scene's graph holds.
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstring>
@@ -189,6 +190,39 @@ TEST(NodeDiameter3D, TheStretchRuleFollowsTheImpactFaceAndTheVolumeRuleLeavesBAl
             EXPECT_LT(largest_height, 2.0 * spacing);
         }
     }
+}
+
+// solver.hourglass_nodes: "all" damps every node whatever switch_plastic_strain says (the lattice
+// regime's bound becomes infinite), "lattice" only the nodes below it. The 3D bar of 5 cells, 150
+// steps after impact (its face has yielded beyond a plastic strain of 0.1): "all" with a bound
+// of 1e-9 is bit for bit "lattice" with a bound no node reaches; "lattice" with the bound of 1e-9
+// spares the yielded nodes, and its hourglass damping does less work.
+TEST(HourglassNodes, AllDampsEveryNodeWhateverTheSwitchingStrain) {
+    struct Result {
+        std::string bytes;
+        double hourglass_work = 0.0;
+        double largest_plastic_strain = 0.0;
+    };
+    const auto run = [](HourglassNodes which, double bound) {
+        auto scene = three_d_cylinder(5);
+        scene.solver.hourglass_nodes = which;
+        scene.solver.switch_plastic_strain = bound;
+        Simulation sim(scene, 2);
+        for (int k = 0; k < 150; ++k) sim.step();
+        Result r{testing::node_bytes(sim), sim.totals().hourglass_work};
+        for (std::size_t i = 0; i < sim.real_count(); ++i) {
+            r.largest_plastic_strain = std::max(r.largest_plastic_strain, sim.nodes().plastic_strain[i]);
+        }
+        return r;
+    };
+    const Result all = run(HourglassNodes::All, 1e-9);
+    const Result everywhere = run(HourglassNodes::Lattice, 1e300);
+    const Result lattice = run(HourglassNodes::Lattice, 1e-9);
+    EXPECT_TRUE(all.bytes == everywhere.bytes);
+    EXPECT_GT(lattice.largest_plastic_strain, 0.1);  // the face has left any lattice regime
+    EXPECT_FALSE(lattice.bytes == all.bytes);
+    EXPECT_GT(all.hourglass_work, 0.0);
+    EXPECT_LT(lattice.hourglass_work, all.hourglass_work);
 }
 
 TEST(NeighbourSkin, CutCandidatesEqualAFullSearchEveryStep) {

@@ -82,7 +82,10 @@ std::vector<SolverOption> make_table() {
                  "C_Q of the viscosity (Eq. 36-37)", ""});
     t.push_back({"bond_viscosity_eps0", number(&S::bond_viscosity_eps0, exclusive(0.0, inf)), "eps0 of the bond viscosity (Eq. 38)", ""});
     t.push_back({"hourglass_coefficient", number(&S::hourglass_coefficient, closed(0.0, 1.0)),
-                 "C_hg, damping of the zero-energy modes of lattice-regime nodes", "0 = off"});
+                 "C_hg, damping of the zero-energy modes of lattice-regime nodes (or of every node: hourglass_nodes)", "0 = off"});
+    t.push_back({"hourglass_nodes",
+                 choice_of(&S::hourglass_nodes, {{"lattice", HourglassNodes::Lattice}, {"all", HourglassNodes::All}}),
+                 "the nodes the hourglass damping acts on: the lattice regime, or every node", ""});
     t.push_back({"hourglass_stiffness", number(&S::hourglass_stiffness, closed(0.0, 1.0)),
                  "C_hs, stiffness against the non-affine displacement of fixed nodes' lattice pairs", "0 = off"});
     t.push_back({"smoothing",

@@ -241,6 +241,17 @@ enum class NodeDiameter {
     Stretch,
 };
 
+// Which nodes the hourglass damping (hourglass_coefficient) acts on (docs/validation.md, "The face
+// pairs in the hoop direction").
+enum class HourglassNodes {
+    // The lattice regime: fixed nodes, and variable nodes whose plastic strain is below
+    // switch_plastic_strain.
+    Lattice,
+    // Every node (its pairs with its own body), however far it has flowed: in 3D it slows the
+    // pairing of an impact face's nodes under hoop tension, which the lattice regime leaves alone.
+    All,
+};
+
 struct SolverOptions {
     ConnectivityMode connectivity = ConnectivityMode::Variable;
     double switch_plastic_strain = 0.1;  // Automatic: switch at this equivalent plastic strain
@@ -261,9 +272,10 @@ struct SolverOptions {
     double viscosity_linear = 0.2;     // C_L (Eq. 36, 37)
     double viscosity_quadratic = 4.0;  // C_Q
     double bond_viscosity_eps0 = 0.01; // Eq. 38
-    // C_hg of the zero-energy-mode control of fixed-connectivity centres (kernels.hpp, spec
-    // section 2): 0 = off. It acts only on fixed nodes (fixed and automatic bodies).
+    // C_hg of the zero-energy-mode control (hourglass.hpp, spec section 2): 0 = off. It acts on the
+    // nodes of hourglass_nodes.
     double hourglass_coefficient = 0.1;
+    HourglassNodes hourglass_nodes = HourglassNodes::Lattice;
     // C_hs of the stiffness form of the control (kernels.hpp, hourglass_stiffness): on fixed nodes,
     // forces against the non-affine part of the lattice pairs' displacement since t = 0, which the
     // damping alone cannot hold under tension (docs/tension.md). 0 = off.

@@ -89,7 +89,7 @@ struct Totals {
     double internal_energy = 0.0;  // sum M e, J (includes plastic, viscous and smoothing heat)
     double plastic_work = 0.0;     // sum M w_p, J
     double viscous_work = 0.0;     // work of artificial viscosity (nodal, bond and hourglass control), J
-    double hourglass_work = 0.0;   // the part of viscous_work done by the hourglass control of fixed nodes, J
+    double hourglass_work = 0.0;   // the part of viscous_work done by the hourglass damping (solver.hourglass_nodes), J
     double hourglass_energy = 0.0; // the part of internal_energy put in by the hourglass stiffness (solver.hourglass_stiffness), J
     double boundary_work = 0.0;    // energy removed by velocity constraints (less the work of prescribed velocities
                                    // and of a program's external forces and set velocities), J
