@@ -1,6 +1,6 @@
 // 3D against 2D at matched spacing (issue 23; docs/validation.md, "3D: the impact face and the
-// node diameter"): the 4340 steel bar at 343 m/s, 10 nodes across its radius in both geometries,
-// run to rest on 2 threads. Long: labelled "slow".
+// node diameter" and "The 3D fill"): the Taylor bars run to rest on 2 threads in both geometries at
+// the same spacing. Long: labelled "slow".
 
 #include <array>
 #include <cmath>
@@ -21,36 +21,69 @@ struct Shape {
     double length = 0.0, footprint = 0.0, narrowest = 0.0, widest = 0.0, peak = 0.0;
 };
 
-// The scene at 10 nodes across the radius, the peaks averaged over the same radius in both
-// geometries (two spacings).
-Shape run(const std::string& file, double refine) {
-    Scene s = io::refined(io::load_scene(std::string(GPA_SOURCE_DIR) + "/scenes/" + file), refine);
+// The scene run to rest, the peaks averaged over two spacings in both geometries.
+Shape run(Scene s, const std::string& label) {
     s.output.peak_radius = 2.0 * s.bodies[0].spacing;
     Simulation sim(s, 2);
     while (!sim.finished()) sim.step();
     sim.measure_bodies();
     const auto& t = sim.totals();
     const Shape out{t.length, t.footprint_diameter, t.footprint_narrowest, t.footprint_widest, t.local.plastic_strain.value};
-    std::printf("[ measured ] %s: L %.4f mm, D %.4f mm (%.4f-%.4f), peak plastic strain %.4f, %zu nodes\n", file.c_str(),
+    std::printf("[ measured ] %s: L %.4f mm, D %.4f mm (%.4f-%.4f), peak plastic strain %.4f, %zu nodes\n", label.c_str(),
                 out.length * 1e3, out.footprint * 1e3, out.narrowest * 1e3, out.widest * 1e3, out.peak, sim.real_count());
     return out;
 }
 
+Scene scene_file(const std::string& file, double refine) {
+    return io::refined(io::load_scene(std::string(GPA_SOURCE_DIR) + "/scenes/" + file), refine);
+}
+
+Shape run(const std::string& file, double refine) { return run(scene_file(file, refine), file); }
+
+// The quarter of a 3D bar standing on the anvil z = 0 with its axis on z: the symmetry planes x = 0
+// and y = 0 cut it, and their ghosts continue it (docs/validation.md, "Half and quarter models": the
+// quarter is the whole bar's quadrant to round-off).
+Scene quarter_of(Scene s) {
+    for (int axis : {0, 1}) {
+        PlaneSpec p;
+        p.name = axis == 0 ? "x-symmetry" : "y-symmetry";
+        p.kind = PlaneKind::Symmetry;
+        p.axis = axis;
+        p.position = 0.0;
+        p.side = +1;
+        s.planes.push_back(p);
+    }
+    return s;
+}
+
 // The issue's bounds for 3D against 2D at matched spacing: length within 1 %, footprint within 2 %,
-// peak plastic strain within 10 %. Measured (docs/validation.md): length +0.14 %, footprint +1.2 %
-// (the volume rule of 3D node diameters: +3.6 %), peak -1.2 %. This bar spreads least of the
-// Taylor bars; copper 190 and steel 208 are still 4-5 % wide of 2D, which this test does not claim.
-TEST(ThreeD, TheSteelBarAt343MetresPerSecondAgreesWithTwoDAtMatchedSpacing) {
-    // scenes/taylor-steel-343.toml has 15 nodes across the radius, its 3D version 8: both to 10.
-    // The scenes' own solver: the node diameter follows the stretch (the default).
-    const Shape plane = run("taylor-steel-343.toml", 10.0 / 15.0);
-    const Shape solid = run("taylor-steel-343-3d.toml", 10.0 / 8.0);
+// peak plastic strain within 10 %; and a round face (widest over narrowest width within 5 %: a face
+// split into spokes along the lattice's rows is wider across its diagonals).
+void expect_agreement(const Shape& solid, const Shape& plane) {
     EXPECT_NEAR(solid.length / plane.length, 1.0, 0.01);
     EXPECT_NEAR(solid.footprint / plane.footprint, 1.0, 0.02);
     EXPECT_NEAR(solid.peak / plane.peak, 1.0, 0.10);
-    // The face is round: its widest and narrowest widths within 5 % (measured 3.4 %; a face split
-    // into spokes along the lattice's rows is wider across its diagonals).
     EXPECT_LT(solid.widest / solid.narrowest, 1.05);
+}
+
+// Measured (2026-12-05, trimmed fill): length +0.34 %, footprint -0.07 %, peak -2.0 %, widest over
+// narrowest 1.013. This bar spreads least of the Taylor bars.
+TEST(ThreeD, TheSteelBarAt343MetresPerSecondAgreesWithTwoDAtMatchedSpacing) {
+    // scenes/taylor-steel-343.toml has 15 nodes across the radius, its 3D version 8: both to 10.
+    // The scenes' own solver: the node diameter follows the stretch (the default).
+    expect_agreement(run("taylor-steel-343-3d.toml", 10.0 / 8.0), run("taylor-steel-343.toml", 10.0 / 15.0));
+}
+
+// The shipped 3D scenes of copper 190 and steel 208 at their 8 nodes across the radius against the
+// 2D scenes at the same spacing (15 across refined to 8), both as quarters. Measured (2026-12-05):
+// copper length -0.03 %, footprint -0.61 %, peak +4.0 %; steel +0.04 %, +0.67 %, +3.1 %; widest
+// over narrowest 1.026 and 1.018. Past 10 nodes across the 3D footprints still grow with refinement
+// (docs/validation.md, "The face pairs in the hoop direction"), which this test does not cover.
+TEST(ThreeD, TheCopperBarAt190AndTheSteelBarAt208AgreeWithTwoDAtTheShippedSpacing) {
+    expect_agreement(run(scene_file("taylor-copper-190-3d-quarter.toml", 1.0), "copper 190, 3D quarter"),
+                     run("taylor-copper-190.toml", 8.0 / 15.0));
+    expect_agreement(run(quarter_of(scene_file("taylor-steel-208-3d.toml", 1.0)), "steel 208, 3D quarter"),
+                     run("taylor-steel-208.toml", 8.0 / 15.0));
 }
 
 // The quarter model of the copper bar (scenes/taylor-copper-190-3d-quarter.toml) against the full bar,
