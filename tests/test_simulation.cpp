@@ -193,10 +193,11 @@ TEST(NodeDiameter3D, TheStretchRuleFollowsTheImpactFaceAndTheVolumeRuleLeavesBAl
 }
 
 // solver.hourglass_nodes: "all" damps every node whatever switch_plastic_strain says (the lattice
-// regime's bound becomes infinite), "lattice" only the nodes below it. The 3D bar of 5 cells, 150
-// steps after impact (its face has yielded beyond a plastic strain of 0.1): "all" with a bound
-// of 1e-9 is bit for bit "lattice" with a bound no node reaches; "lattice" with the bound of 1e-9
-// spares the yielded nodes, and its hourglass damping does less work.
+// regime's bound becomes infinite), "lattice" only the nodes below it, and "automatic" (the
+// default) is "all" in 3D and "lattice" in 2D. The 3D bar of 5 cells, 150 steps after impact (its
+// face has yielded beyond a plastic strain of 0.1): "all" with a bound of 1e-9 is bit for bit
+// "lattice" with a bound no node reaches, and the default; "lattice" with the bound of 1e-9 spares
+// the yielded nodes, and its hourglass damping does less work.
 TEST(HourglassNodes, AllDampsEveryNodeWhateverTheSwitchingStrain) {
     struct Result {
         std::string bytes;
@@ -218,7 +219,13 @@ TEST(HourglassNodes, AllDampsEveryNodeWhateverTheSwitchingStrain) {
     const Result all = run(HourglassNodes::All, 1e-9);
     const Result everywhere = run(HourglassNodes::Lattice, 1e300);
     const Result lattice = run(HourglassNodes::Lattice, 1e-9);
+    const Result automatic = run(HourglassNodes::Automatic, 1e-9);
     EXPECT_TRUE(all.bytes == everywhere.bytes);
+    EXPECT_TRUE(automatic.bytes == all.bytes);
+    EXPECT_EQ(SolverOptions{}.hourglass_nodes, HourglassNodes::Automatic);
+    EXPECT_TRUE(hourglass_damps_every_node(SolverOptions{}, GeometryKind::ThreeD));
+    EXPECT_FALSE(hourglass_damps_every_node(SolverOptions{}, GeometryKind::Axisymmetric));
+    EXPECT_FALSE(hourglass_damps_every_node(SolverOptions{}, GeometryKind::PlaneStrain));
     EXPECT_GT(lattice.largest_plastic_strain, 0.1);  // the face has left any lattice regime
     EXPECT_FALSE(lattice.bytes == all.bytes);
     EXPECT_GT(all.hourglass_work, 0.0);

@@ -84,8 +84,12 @@ std::vector<SolverOption> make_table() {
     t.push_back({"hourglass_coefficient", number(&S::hourglass_coefficient, closed(0.0, 1.0)),
                  "C_hg, damping of the zero-energy modes of lattice-regime nodes (or of every node: hourglass_nodes)", "0 = off"});
     t.push_back({"hourglass_nodes",
-                 choice_of(&S::hourglass_nodes, {{"lattice", HourglassNodes::Lattice}, {"all", HourglassNodes::All}}),
-                 "the nodes the hourglass damping acts on: the lattice regime, or every node", ""});
+                 choice_of(&S::hourglass_nodes, {{"automatic", HourglassNodes::Automatic},
+                                                 {"lattice", HourglassNodes::Lattice},
+                                                 {"all", HourglassNodes::All}}),
+                 "the nodes the hourglass damping acts on: the lattice regime, every node that has not failed, or "
+                 "automatic (every node in 3D, the lattice regime in 2D)",
+                 ""});
     t.push_back({"hourglass_stiffness", number(&S::hourglass_stiffness, closed(0.0, 1.0)),
                  "C_hs, stiffness against the non-affine displacement of fixed nodes' lattice pairs", "0 = off"});
     t.push_back({"smoothing",

@@ -401,12 +401,13 @@ template <class G>
 HourglassFields<G::dim> Simulation::Impl::hourglass_control_fields(double* power, double* stiffness_power) {
     // The hourglass control's fields (hourglass.hpp), its powers per centre into `power` and
     // `stiffness_power`.
-    // The damping's regime: below the switching strain, or everywhere (an infinite bound).
-    const double lattice_plastic_strain = scene.solver.hourglass_nodes == HourglassNodes::All
-                                              ? std::numeric_limits<double>::infinity()
-                                              : scene.solver.switch_plastic_strain;
+    // The damping's regime: below the switching strain, or every node (an infinite bound) but the
+    // failed ones, which are debris without a continuum to fit.
+    const bool every_node = hourglass_damps_every_node(scene.solver, scene.geometry);
+    const double lattice_plastic_strain =
+        every_node ? std::numeric_limits<double>::infinity() : scene.solver.switch_plastic_strain;
     auto h = hourglass_fields<G::dim>(nodes, lattice_plastic_strain, power, scene.solver.hourglass_stiffness, stiffness_power);
-    if (contact.sliding() && contact.failed_pairs_separate()) h.failed = nodes.failed.data();
+    if (every_node || (contact.sliding() && contact.failed_pairs_separate())) h.failed = nodes.failed.data();
     h.ghost_continues = ghosts.continuing_flags();
     return h;
 }

@@ -27,7 +27,8 @@ struct HourglassFields {
     const Connectivity* connectivity = nullptr;
     const std::int32_t* body = nullptr;
     // Set when the pairs of failed nodes separate (separation.hpp): a crack is no pair of the
-    // control (its faces slide freely, spec section 2 "[spec] Sliding contact").
+    // control (its faces slide freely, spec section 2 "[spec] Sliding contact"); and when the
+    // control acts on every node (SolverOptions::hourglass_nodes), whose failed nodes are debris.
     const std::uint8_t* failed = nullptr;
     // Per ghost (index j - real_count), 1 where the ghost continues the body across symmetry planes
     // (a half or quarter model): its pairs are controlled like those of the real node it mirrors, so

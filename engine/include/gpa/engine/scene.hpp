@@ -244,11 +244,15 @@ enum class NodeDiameter {
 // Which nodes the hourglass damping (hourglass_coefficient) acts on (docs/validation.md, "The face
 // pairs in the hoop direction").
 enum class HourglassNodes {
+    // Every node in 3D, the lattice regime in 2D (hourglass_damps_every_node): the face's pairing
+    // needs a discretised hoop direction, which axisymmetric bodies do not have. The default.
+    Automatic,
     // The lattice regime: fixed nodes, and variable nodes whose plastic strain is below
     // switch_plastic_strain.
     Lattice,
-    // Every node (its pairs with its own body), however far it has flowed: in 3D it slows the
-    // pairing of an impact face's nodes under hoop tension, which the lattice regime leaves alone.
+    // Every node that has not failed (its pairs with its own body), however far it has flowed: in
+    // 3D it holds the pairing of an impact face's nodes under hoop tension, which the lattice regime
+    // leaves alone.
     All,
 };
 
@@ -275,7 +279,7 @@ struct SolverOptions {
     // C_hg of the zero-energy-mode control (hourglass.hpp, spec section 2): 0 = off. It acts on the
     // nodes of hourglass_nodes.
     double hourglass_coefficient = 0.1;
-    HourglassNodes hourglass_nodes = HourglassNodes::Lattice;
+    HourglassNodes hourglass_nodes = HourglassNodes::Automatic;
     // C_hs of the stiffness form of the control (kernels.hpp, hourglass_stiffness): on fixed nodes,
     // forces against the non-affine part of the lattice pairs' displacement since t = 0, which the
     // damping alone cannot hold under tension (docs/tension.md). 0 = off.
@@ -369,6 +373,13 @@ struct Scene {
     // written; relative paths are taken from the scene file's folder (io::load_scene resolves them).
     std::string element_reference;
 };
+
+// Whether the hourglass damping acts on every node (SolverOptions::hourglass_nodes), the automatic
+// choice resolved by the scene's geometry.
+inline bool hourglass_damps_every_node(const SolverOptions& solver, GeometryKind geometry) {
+    if (solver.hourglass_nodes == HourglassNodes::Automatic) return geometry == GeometryKind::ThreeD;
+    return solver.hourglass_nodes == HourglassNodes::All;
+}
 
 // Throws InputError naming the body, plane or option when the scene is impossible (no bodies,
 // a body with a non-positive size or spacing, an unknown material name, a plane on a body's
