@@ -5,6 +5,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <map>
 #include <string>
 
@@ -35,7 +36,7 @@ Shape run(Scene s, const std::string& label) {
 }
 
 Scene scene_file(const std::string& file, double refine) {
-    return io::refined(io::load_scene(std::string(GPA_SOURCE_DIR) + "/scenes/" + file), refine);
+    return io::refined(io::load_scene(std::filesystem::path(GPA_SOURCE_DIR) / "scenes" / file), refine);
 }
 
 Shape run(const std::string& file, double refine) { return run(scene_file(file, refine), file); }
@@ -104,14 +105,14 @@ TEST(ThreeD, TheCopperAndSteelBarsAndThePapersCylinderAgreeWithTwoDAtTheShippedS
 // that node back in front of the plane and differed from the full bar by 30 m/s from there on; the
 // shorter runs of tests/test_symmetry.cpp see no node cross.
 TEST(ThreeD, AQuarterOfTheCopperBarIsTheFullBarThroughANodeCrossingASymmetryPlane) {
-    const std::string dir = std::string(GPA_SOURCE_DIR) + "/scenes/";
+    const std::filesystem::path dir = std::filesystem::path(GPA_SOURCE_DIR) / "scenes";
     // The cubic lattice of cells whose centres lie inside (CellFill::Centres) and the hourglass
     // damping on the lattice regime alone: with them two mirror nodes of the face pass each other at
     // step 407; with either the trimmed fill or the damping on every node (the 3D defaults) no node
     // crosses within 420 steps (the damping keeps the face's nodes from pairing up across the
     // planes). The guard's rule depends on neither.
-    Scene quarter_scene = io::load_scene(dir + "taylor-copper-190-3d-quarter.toml");
-    Scene full_scene = io::load_scene(dir + "taylor-copper-190-3d.toml");
+    Scene quarter_scene = io::load_scene(dir / "taylor-copper-190-3d-quarter.toml");
+    Scene full_scene = io::load_scene(dir / "taylor-copper-190-3d.toml");
     for (Scene* s : {&quarter_scene, &full_scene}) {
         s->bodies[0].fill = CellFill::Centres;
         s->solver.hourglass_nodes = HourglassNodes::Lattice;
