@@ -87,7 +87,12 @@ HourglassPower hourglass_centre(std::span<const NodeIndex> row, std::size_t i, c
     const auto invert = [](const HourglassFit<D>& fit, Mat<D>& inverse) {
         bool invertible = false;
         double determinant = 0.0;
-        fit.moment.computeInverseAndDetWithCheck(inverse, determinant, invertible, 1e-12 * std::pow(fit.moment.trace(), D));
+        // The determinant's scale, trace^D, multiplied out: std::pow(trace, 3) is a call to libm's
+        // pow at every centre of a 3D step.
+        const double trace = fit.moment.trace();
+        double scale = trace;
+        for (int k = 1; k < D; ++k) scale *= trace;
+        fit.moment.computeInverseAndDetWithCheck(inverse, determinant, invertible, 1e-12 * scale);
         return invertible && fit.weight > 0.0;
     };
     // The controlled pairs of the row with their offsets and weights, found once for the fit and
