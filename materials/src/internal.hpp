@@ -78,12 +78,13 @@ struct ReturnResult {
 // eps_p, strain rate (1/s) and homologous temperature; shear modulus G (Pa). dt: the step's length;
 // the Johnson-Cook rate term uses the equivalent plastic strain rate d eps_p / dt of the return
 // itself (Johnson and Cook 1983 define epsdot* so). One overload per model (a PointModel picks it
-// once per material).
+// once per material). previous_rate: the point's d eps_p / dt of its last step (PointState::
+// plastic_strain_rate), where the Johnson-Cook iteration starts; the other models do not iterate.
 ReturnResult model_return(const ElasticStrength& strength, const Eigen::Matrix3d& trial, double shear_modulus,
-                          double plastic_strain, double dt, double homologous_temperature);
+                          double plastic_strain, double dt, double homologous_temperature, double previous_rate);
 ReturnResult model_return(const VonMisesStrength& strength, const Eigen::Matrix3d& trial, double shear_modulus,
-                          double plastic_strain, double dt, double homologous_temperature);
+                          double plastic_strain, double dt, double homologous_temperature, double previous_rate);
 ReturnResult model_return(const JohnsonCookStrength& strength, const Eigen::Matrix3d& trial, double shear_modulus,
-                          double plastic_strain, double dt, double homologous_temperature);
+                          double plastic_strain, double dt, double homologous_temperature, double previous_rate);
 
 }  // namespace gpa::materials::detail

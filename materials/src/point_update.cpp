@@ -115,7 +115,8 @@ PointResult update_with(const PointModel& model, PointState& state, const PointI
         trial = (0.5 * (trial + trial.transpose())).eval();  // eval: no aliasing with transpose
         trial -= (trial.trace() / 3.0) * identity;
         const detail::ReturnResult r =
-            detail::model_return(strength, trial, m.shear_modulus, state.plastic_strain, inc.dt, t_star);
+            detail::model_return(strength, trial, m.shear_modulus, state.plastic_strain, inc.dt, t_star,
+                                 state.plastic_strain_rate);
         s_new = r.deviator;
         return_iterations = r.iterations;
         plastic_increment = r.plastic_strain_increment;
@@ -199,6 +200,7 @@ PointResult update_with(const PointModel& model, PointState& state, const PointI
     state.pressure = pressure;
     state.specific_internal_energy = energy;
     state.plastic_strain += plastic_increment;
+    state.plastic_strain_rate = plastic_rate;
 
     // 8. Sound speed.
     const double k_s = detail::isentropic_bulk_modulus(eos, reference_bulk, rho_new, energy);

@@ -92,7 +92,7 @@ void ElementNodes::resize(std::size_t n) {
 
 void ElementPoints::resize(std::size_t n) {
     for (auto& s : deviatoric_stress) s.resize(n, 0.0);
-    for (auto* f : {&pressure, &viscous_pressure, &sound_speed, &internal_energy, &temperature, &plastic_strain, &damage,
+    for (auto* f : {&pressure, &viscous_pressure, &sound_speed, &internal_energy, &temperature, &plastic_strain, &plastic_strain_rate, &damage,
                     &plastic_work, &viscous_work, &mass, &density, &volume}) {
         f->resize(n, 0.0);
     }
@@ -405,6 +405,7 @@ void for_each_state_array(Mesh& m, F&& f) {
     f(m.points.internal_energy);
     f(m.points.temperature);
     f(m.points.plastic_strain);
+    f(m.points.plastic_strain_rate);
     f(m.points.damage);
     f(m.points.plastic_work);
     f(m.points.viscous_work);

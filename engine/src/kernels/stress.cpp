@@ -66,6 +66,7 @@ materials::PointState point_state(const MaterialPointFields& f, std::size_t i) {
     state.pressure = f.pressure[i];
     state.specific_internal_energy = f.internal_energy[i];
     state.plastic_strain = f.plastic_strain[i];
+    state.plastic_strain_rate = f.plastic_strain_rate[i];
     state.temperature = f.temperature[i];
     state.damage = f.damage[i];
     state.failed = f.failed[i] != 0;
@@ -84,6 +85,7 @@ materials::PointResult advance_material_point(const MaterialPointFields& f, std:
     f.pressure[i] = state.pressure;
     f.internal_energy[i] = state.specific_internal_energy;
     f.plastic_strain[i] = state.plastic_strain;
+    f.plastic_strain_rate[i] = state.plastic_strain_rate;
     f.temperature[i] = state.temperature;
     f.damage[i] = state.damage;
     f.failed[i] = state.failed ? 1 : 0;

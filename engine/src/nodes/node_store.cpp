@@ -55,6 +55,7 @@ void NodeStore::for_each_field(F&& f) {
     f("internal_energy", internal_energy);
     f("temperature", temperature);
     f("plastic_strain", plastic_strain);
+    f("plastic_strain_rate", plastic_strain_rate);
     f("damage", damage);
     f("plastic_work", plastic_work);
     f("viscous_work", viscous_work);

@@ -79,6 +79,7 @@ struct ElementPoints {
     std::vector<double> internal_energy;   // specific, J/kg
     std::vector<double> temperature;       // K
     std::vector<double> plastic_strain;
+    std::vector<double> plastic_strain_rate;  // d eps_p / dt of the last step, 1/s (materials::PointState)
     std::vector<double> damage;
     std::vector<double> plastic_work;      // accumulated specific, J/kg
     std::vector<double> viscous_work;      // accumulated specific, J/kg

@@ -66,6 +66,7 @@ public:
     std::vector<double> internal_energy;           // specific, J/kg
     std::vector<double> temperature;               // K
     std::vector<double> plastic_strain;            // equivalent plastic strain
+    std::vector<double> plastic_strain_rate;       // d eps_p / dt of the last step, 1/s (materials::PointState)
     std::vector<double> damage;                    // Johnson-Cook damage D
     std::vector<double> plastic_work;              // accumulated specific plastic work, J/kg
     std::vector<double> viscous_work;              // accumulated specific artificial-viscous work, J/kg

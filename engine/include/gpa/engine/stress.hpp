@@ -64,6 +64,7 @@ struct MaterialPointFields {
     double* pressure = nullptr;
     double* internal_energy = nullptr;  // specific, J/kg
     double* plastic_strain = nullptr;
+    double* plastic_strain_rate = nullptr;  // 1/s, where the Johnson-Cook return starts (materials::PointState)
     double* temperature = nullptr;
     double* damage = nullptr;
     std::uint8_t* failed = nullptr;
@@ -81,6 +82,7 @@ MaterialPointFields material_point_fields(Store& store, int components) {
     f.pressure = store.pressure.data();
     f.internal_energy = store.internal_energy.data();
     f.plastic_strain = store.plastic_strain.data();
+    f.plastic_strain_rate = store.plastic_strain_rate.data();
     f.temperature = store.temperature.data();
     f.damage = store.damage.data();
     f.failed = store.failed.data();

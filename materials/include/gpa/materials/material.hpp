@@ -136,6 +136,11 @@ struct PointState {
     double plastic_strain = 0.0;          // equivalent plastic strain
     double temperature = 294.0;           // K
     double damage = 0.0;                  // Johnson-Cook D
+    // d eps_p / dt of the point's last step, 1/s (0 where it stayed elastic): the Johnson-Cook
+    // return starts its iteration at this rate times the new step (strength.cpp). Only the
+    // iteration's path depends on it, not its answer (to the return's tolerance, 1e-13 of the
+    // trial stress); a caller that does not keep it passes 0 and the iteration starts cold.
+    double plastic_strain_rate = 0.0;
     bool failed = false;
 };
 
