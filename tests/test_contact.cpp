@@ -14,6 +14,7 @@
 #include "gpa/engine/drivers.hpp"
 #include "gpa/engine/fields.hpp"
 #include "gpa/engine/neighbours.hpp"
+#include "gpa/engine/parallel.hpp"
 #include "gpa/engine/separation.hpp"
 #include "gpa/engine/simulation.hpp"
 #include "support/lattices.hpp"
@@ -62,6 +63,48 @@ TEST(Separation, BothEndsOfEveryPairGiveTheSameAnswerAndTheListsStaySymmetric) {
         }
         for (const auto& [i, j] : pairs) ASSERT_TRUE(pairs.count({j, i})) << "pair " << i << "-" << j << " kept on one side only";
     }
+}
+
+TEST(Separation, BlocksOfRowsCutInParallelGiveTheRowByRowListsOnOneAndTwoThreads) {
+    // remove_open_pairs cuts blocks of 1024 rows in parallel, each inside its own stretch of the
+    // entries, then moves the blocks together. 60 x 60 cells (3721 rows: four blocks, the last
+    // short), with failed nodes scattered through both bodies so that every block loses entries:
+    // the rows must be, entry for entry and in order, a row-by-row filter by pair_is_open, and the
+    // closing speeds and contact directions the same on 1 and 2 threads.
+    testing::LatticeOptions o;
+    o.cells = 60;
+    o.spacing = 0.01;
+    NodeStore n = testing::make_lattice(o);
+    testing::jitter(n, 0.2, o.spacing, 7);
+    testing::randomise_state(n, 8);
+    for (std::size_t i = 0; i < n.size(); ++i) n.body[i] = n.position[0][i] < 0.3 ? 0 : 1;
+    for (std::size_t i = 0; i < n.size(); i += 11) n.failed[i] = 1;
+    ASSERT_GT(n.size(), 3u * 1024u);
+    const CompressedRows searched = find_neighbours(n, 1.0, n.size());
+    CompressedRows expected;
+    expected.offsets.assign(1, 0);
+    for (std::size_t i = 0; i < n.size(); ++i) {
+        for (NodeIndex j : searched.row(i)) {
+            if (!pair_is_open(n, i, j, true)) expected.indices.push_back(j);
+        }
+        expected.offsets.push_back(expected.indices.size());
+    }
+    ASSERT_LT(expected.indices.size(), searched.indices.size() - 200) << "too few pairs open to see a block's move";
+    std::vector<std::vector<double>> closing(2), direction(2);
+    for (int threads : {1, 2}) {
+        CompressedRows lists = searched;
+        std::vector<double> speed(n.size(), -1.0), x(n.size(), -1.0), z(n.size(), -1.0);
+        ThreadScope scope(threads);
+        scope.run([&] { remove_open_pairs(lists, n, n.size(), true, speed.data(), {x.data(), z.data(), nullptr}, 1.0); });
+        ASSERT_EQ(lists.offsets, expected.offsets) << threads << " thread(s)";
+        ASSERT_EQ(lists.indices, expected.indices) << threads << " thread(s)";
+        closing[threads - 1] = speed;
+        direction[threads - 1] = x;
+        direction[threads - 1].insert(direction[threads - 1].end(), z.begin(), z.end());
+    }
+    EXPECT_EQ(closing[0], closing[1]);
+    EXPECT_EQ(direction[0], direction[1]);
+    EXPECT_GT(*std::max_element(closing[0].begin(), closing[0].end()), 0.0) << "some pair must be closing";
 }
 
 TEST(Separation, APairOpensOnlyWhenItSeparatesWithoutCompression) {
