@@ -1,6 +1,7 @@
 #include "gpa/engine/ghosts.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <bit>
 #include <cmath>
 #include <limits>
@@ -417,21 +418,34 @@ void GhostSet::append_ghost_rows(CompressedRows& lists, std::size_t real_count) 
     }
     // Ghost centre mirror(s, S) gets real j for every entry mirror(j, S) of s's list. Only a node
     // with ghosts of its own can list a ghost (it is then within reach of the same planes), so
-    // only those rows are read.
+    // only those rows are read. A ghost row takes entries from its own source's row only, so both
+    // passes below run over the sources in parallel without two writing one place, and a row's
+    // entries keep the order of its source's row whatever the threads.
     const auto target = [&](std::size_t s, NodeIndex entry) -> std::int64_t {
         return index_[slot_[entry - real_count]][s];
     };
+    constexpr std::size_t grain = 256;  // sources per task
+    const tbb::blocked_range<std::size_t> all_sources(0, sources_sorted_.size(), grain);
     std::vector<std::size_t> count(ghosts + 1, 0);
-    for (const NodeIndex s : sources_sorted_) {
-        for (NodeIndex j : lists.row(s)) {
-            if (j < real_count) continue;
-            const std::int64_t t = target(s, j);
-            if (t < 0) {
-                throw NumericalError(fmt::format(
-                    "node {} lists a ghost whose mirror pair is missing (the ghost range is too short)", s));
+    std::atomic<std::size_t> first_missing{std::numeric_limits<std::size_t>::max()};  // the smallest source at fault
+    tbb::parallel_for(all_sources, [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t q = r.begin(); q != r.end(); ++q) {
+            const NodeIndex s = sources_sorted_[q];
+            for (NodeIndex j : lists.row(s)) {
+                if (j < real_count) continue;
+                const std::int64_t t = target(s, j);
+                if (t < 0) {
+                    std::size_t seen = first_missing.load();
+                    while (s < seen && !first_missing.compare_exchange_weak(seen, s)) {
+                    }
+                    break;
+                }
+                ++count[static_cast<std::size_t>(t) - real_count + 1];
             }
-            ++count[static_cast<std::size_t>(t) - real_count + 1];
         }
+    });
+    if (const std::size_t s = first_missing.load(); s != std::numeric_limits<std::size_t>::max()) {
+        throw NumericalError(fmt::format("node {} lists a ghost whose mirror pair is missing (the ghost range is too short)", s));
     }
     const std::size_t base = lists.entries();
     resize_with_slack(lists.offsets, real_count + ghosts + 1);
@@ -442,14 +456,17 @@ void GhostSet::append_ghost_rows(CompressedRows& lists, std::size_t real_count) 
     resize_with_slack(lists.indices, base + count[ghosts]);
     std::vector<std::size_t> next(ghosts);
     for (std::size_t k = 0; k < ghosts; ++k) next[k] = base + count[k];
-    for (const NodeIndex s : sources_sorted_) {
-        for (std::size_t e = lists.offsets[s]; e < lists.offsets[s + 1]; ++e) {
-            const NodeIndex j = lists.indices[e];
-            if (j < real_count) continue;
-            const std::size_t t = static_cast<std::size_t>(target(s, j)) - real_count;
-            lists.indices[next[t]++] = source_[j - real_count];
+    tbb::parallel_for(all_sources, [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t q = r.begin(); q != r.end(); ++q) {
+            const NodeIndex s = sources_sorted_[q];
+            for (std::size_t e = lists.offsets[s]; e < lists.offsets[s + 1]; ++e) {
+                const NodeIndex j = lists.indices[e];
+                if (j < real_count) continue;
+                const std::size_t t = static_cast<std::size_t>(target(s, j)) - real_count;
+                lists.indices[next[t]++] = source_[j - real_count];
+            }
         }
-    }
+    });
 }
 
 const std::uint8_t* GhostSet::continuing_flags() {
