@@ -334,8 +334,8 @@ TEST_P(Conservation, StressPowerAtOtherVelocitiesWithTheMomentMatrixNormalisatio
     dispatch_geometry(s.geometry, [&](auto g) { check_stress_power<decltype(g)>(s, true); });
 }
 
-// The pair terms the gradient sweep keeps (fields.hpp, PairFields::kept_weight) are the weight and
-// inverse distance that pair() makes, and the sweeps that read them (forces, stress power,
+// The pair terms the gradient sweep keeps (fields.hpp, PairFields::kept_weight_over_r2) are the
+// R / r^2 that pair() makes, and the sweeps that read them (forces, stress power,
 // smoothing) give what they give without them, bit for bit, on rows that have them and on rows
 // that do not (the ghost rows of a run).
 template <class G>
@@ -344,13 +344,12 @@ void check_kept_pair_terms(const ForceCase& s, bool full_normalisation) {
     NodeStore fresh = random_body(s);
     const CompressedRows lists = find_neighbours(fresh, influence, fresh.size());
     NodeStore kept = fresh;
-    std::vector<double> weight(lists.entries(), -1.0), inverse_distance(lists.entries(), -1.0);
+    std::vector<double> weight_over_r2(lists.entries(), -1.0);
     // The gradient with and without keeping: the same outputs, and the kept numbers are pair()'s.
     auto g_fresh = gradient_fields<D>(fresh, influence);
     auto g_kept = gradient_fields<D>(kept, influence);
     g_fresh.full_normalisation = g_kept.full_normalisation = full_normalisation;
-    g_kept.keep_weight = weight.data();
-    g_kept.keep_inverse_distance = inverse_distance.data();
+    g_kept.keep_weight_over_r2 = weight_over_r2.data();
     compute_velocity_gradient<G>(lists, s.weight, g_fresh);
     compute_velocity_gradient<G>(lists, s.weight, g_kept);
     for (std::size_t i = 0; i < fresh.size(); ++i) {
@@ -358,16 +357,15 @@ void check_kept_pair_terms(const ForceCase& s, bool full_normalisation) {
         const auto row = lists.row(i);
         for (std::size_t k = 0; k < row.size(); ++k) {
             const auto p = dispatch_weight(s.weight, [&](auto w) { return g_fresh.pairs.template pair<decltype(w)>(i, row[k]); });
-            ASSERT_EQ(weight[lists.offsets[i] + k], p.R) << name(s) << " centre " << i;
-            ASSERT_EQ(inverse_distance[lists.offsets[i] + k], p.inv_r) << name(s) << " centre " << i;
+            ASSERT_EQ(weight_over_r2[lists.offsets[i] + k], p.R_over_r2) << name(s) << " centre " << i;
+            ASSERT_EQ(p.R_over_r2, p.R * p.inv_r * p.inv_r) << name(s) << " centre " << i;
         }
     }
     // The forces, the stress power and the smoothing, with the kept terms for the first half of
     // the rows (the rest make their own) and without any.
     const std::size_t kept_rows = fresh.size() / 2;
     const auto with_kept = [&](PairFields<D> p) {
-        p.kept_weight = weight.data();
-        p.kept_inverse_distance = inverse_distance.data();
+        p.kept_weight_over_r2 = weight_over_r2.data();
         p.kept_rows = kept_rows;
         return p;
     };

@@ -30,7 +30,7 @@ struct UnitLattice {
         const auto p = f.pairs.pair<GpaWeight>(i, j);
         const Vec<2> alpha(nodes.alpha[0][i], nodes.alpha[1][i]);
         const auto sigma = cauchy_stress<PlaneStrain>(f.deviatoric_stress, f.pressure, nullptr, i);
-        return pair_force(p, nodes.volume[i], nodes.size_weight[j], alpha.cwiseProduct(p.l).eval(), sigma, 0.0)[1];
+        return pair_force(p, nodes.volume[i], nodes.size_weight[j], alpha.cwiseProduct(p.dx).eval(), sigma, 0.0)[1];
     }
 };
 

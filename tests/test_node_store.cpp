@@ -101,7 +101,7 @@ TEST(Kernels, ArtificialViscosityActsOnlyInCompression) {
     EXPECT_EQ(bond_viscosity(0.5, 1000.0, 5000.0, 0.2, 4.0), 0.0);
     EXPECT_DOUBLE_EQ(bond_viscosity(-2.0, 1000.0, 5000.0, 0.2, 4.0), 0.2 * 1000.0 * 5000.0 * 2.0 + 4.0 * 1000.0 * 4.0);
     // Eq. 38: approaching nodes have mu < 0.
-    PairGeometry<2> p{Vec<2>(1.0, 0.0), 0.002, 1.0 / 0.002, 0.001, 0.0};
+    PairGeometry<2> p{Vec<2>(1.0, 0.0), 0.002, 1.0 / 0.002, 0.001, 0.0, Vec<2>(0.002, 0.0), 0.0};
     EXPECT_LT(bond_compression_rate(p, Vec<2>(-1.0, 0.0).eval(), 0.01), 0.0);
     EXPECT_NEAR(bond_compression_rate(p, Vec<2>(-1.0, 0.0).eval(), 0.01), -0.001 * 0.002 / (0.002 * 0.002 + 0.01 * 1e-6), 1e-15);
 }

@@ -53,7 +53,7 @@ struct StressedBlock {
         const auto f = force_fields<2>(const_cast<NodeStore&>(nodes), 1.0);
         const auto p = f.pairs.pair<GpaWeight>(i, j);
         const auto sigma = cauchy_stress<PlaneStrain>(f.deviatoric_stress, f.pressure, nullptr, i);
-        return pair_force(p, nodes.volume[i], nodes.size_weight[j], (normalisation(i) * p.l).eval(), sigma, 0.0)[1];
+        return pair_force(p, nodes.volume[i], nodes.size_weight[j], (normalisation(i) * p.dx).eval(), sigma, 0.0)[1];
     }
 
     // |sum over the neighbours at z + dz of (i's force on them - theirs on i)|, z-components.

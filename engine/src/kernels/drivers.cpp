@@ -124,7 +124,7 @@ template <class G, class W, bool full>
 void gradient_impl(const CompressedRows& lists, const GradientFields<G::dim>& f, std::size_t n) {
     constexpr int D = G::dim;
     std::atomic<std::size_t> first_bad{no_node};
-    const bool keep = f.keep_weight != nullptr && f.keep_inverse_distance != nullptr;
+    const bool keep = f.keep_weight_over_r2 != nullptr;
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, row_grain), [&](const tbb::blocked_range<std::size_t>& range) {
         for (std::size_t i = range.begin(); i != range.end(); ++i) {
             const Vec<D> v_i = load<D>(f.velocity, i);
@@ -136,10 +136,7 @@ void gradient_impl(const CompressedRows& lists, const GradientFields<G::dim>& f,
                 const NodeIndex j = row[k];
                 const auto p = f.pairs.template pair<W>(i, j);
                 ok &= p.r > 0.0;
-                if (keep) {
-                    f.keep_weight[first + k] = p.R;
-                    f.keep_inverse_distance[first + k] = p.inv_r;
-                }
+                if (keep) f.keep_weight_over_r2[first + k] = p.R_over_r2;
                 Vec<D> dv = load<D>(f.velocity, j) - v_i;
                 if (f.pairs.sliding(i, j)) dv = along_pair<D>(f.pairs.sliding_normal(i, j, p.l), dv);  // spec section 2
                 accumulate_gradient<D, full>(p, f.size_weight[j], dv, sums);
@@ -256,7 +253,8 @@ void forces_impl(const CompressedRows& lists, const ScatterPlan& plan, const Bon
             // The bond viscosity reads r and h, which the kept pairs leave out (fields.hpp).
             const auto p = with_bond_viscosity ? f.pairs.template pair<W>(i, j) : f.pairs.template pair<W>(i, j, first + k);
             const bool sliding = f.pairs.sliding(i, j);  // spec section 2: one direction only
-            [[maybe_unused]] const Vec<D> n = sliding ? f.pairs.sliding_normal(i, j, p.l) : p.l;  // contact normal, read only when sliding
+            // The contact normal, read only when sliding (a kept pair has no l: its direction made).
+            [[maybe_unused]] const Vec<D> n = sliding ? f.pairs.sliding_normal(i, j, PairFields<D>::direction(p.dx)) : Vec<D>::Zero().eval();
             double q = 0.0;
             [[maybe_unused]] Vec<D> dv;
             if constexpr (with_bond_viscosity) {
@@ -265,13 +263,13 @@ void forces_impl(const CompressedRows& lists, const ScatterPlan& plan, const Bon
                 const double mu = bond_compression_rate(p, dv, bond.eps0);  // Eq. 38
                 q = bond_viscosity(mu, density, sound_speed, bond.linear, bond.quadratic);  // Eq. 37
             }
-            Vec<D> normalised_l;
+            Vec<D> normalised_dx;
             if constexpr (full) {
-                normalised_l = normalisation * p.l;  // spec section 7: M_i^-1 l
+                normalised_dx = normalisation * p.dx;  // spec section 7: M_i^-1 dx
             } else {
-                normalised_l = alpha.cwiseProduct(p.l);  // alpha_b l_b
+                normalised_dx = alpha.cwiseProduct(p.dx);  // alpha_b dx_b
             }
-            Vec<D> force_on_j = pair_force(p, volume, f.size_weight[j], normalised_l, sigma, q);  // Eq. 21-22
+            Vec<D> force_on_j = pair_force(p, volume, f.size_weight[j], normalised_dx, sigma, q);  // Eq. 21-22
             if (sliding) force_on_j = along_pair<D>(n, force_on_j);
             if constexpr (with_bond_viscosity) {
                 if (f.largest_bond_viscosity) largest_q = std::max(largest_q, q);
@@ -280,7 +278,7 @@ void forces_impl(const CompressedRows& lists, const ScatterPlan& plan, const Bon
             on_centre -= force_on_j;  // Eq. 23-24
             if constexpr (with_bond_viscosity) {
                 // The work rate of the -Q_ij part of this pair's force (spec section 5).
-                bond_power += p.R * volume * f.size_weight[j] * q / p.r * normalised_l.dot(dv);
+                bond_power += p.R_over_r2 * volume * f.size_weight[j] * q * normalised_dx.dot(dv);
             }
         }
         if constexpr (G::axisymmetric) {
@@ -328,7 +326,7 @@ void stress_difference_impl(const CompressedRows& lists, const ScatterPlan& plan
         for (NodeIndex j : row) {
             const auto p = f.pairs.template pair<W>(i, j);
             const Mat<D> sigma_j = cauchy_stress<G>(f.deviatoric_stress, f.pressure, f.viscous_pressure, j);
-            Vec<D> term = stress_difference_term(p, volume, f.size_weight[j], Vec<D>(normalisation * p.l), sigma_j, kept_sigma_i);
+            Vec<D> term = stress_difference_term(p, volume, f.size_weight[j], Vec<D>(normalisation * p.dx), sigma_j, kept_sigma_i);
             if (f.pairs.sliding(i, j)) term = along_pair<D>(f.pairs.sliding_normal(i, j, p.l), term);  // spec section 2
             on_centre += term;
             if (j >= real) {
@@ -369,7 +367,9 @@ void stress_power_impl(const CompressedRows& lists, const ForceFields<G::dim>& f
                 const NodeIndex j = row[k];
                 const auto p = f.pairs.template pair<W>(i, j, first + k);
                 Vec<D> dv = load<D>(velocity, j) - v_i;
-                if (f.pairs.sliding(i, j)) dv = along_pair<D>(f.pairs.sliding_normal(i, j, p.l), dv);  // spec section 2
+                if (f.pairs.sliding(i, j)) {
+                    dv = along_pair<D>(f.pairs.sliding_normal(i, j, PairFields<D>::direction(p.dx)), dv);  // spec section 2
+                }
                 accumulate_velocity_difference<D>(p, f.size_weight[j], dv, difference);
             }
             double sum = -volume * (sigma * normalisation).cwiseProduct(difference).sum();  // Eq. 21-22 summed over j

@@ -60,24 +60,19 @@ void NeighbourLists::invalidate() {
 
 void NeighbourLists::forget_kept_arrays() {
     kept_rows_ = 0;
-    std::vector<double>().swap(kept_weight_);
-    std::vector<double>().swap(kept_inverse_distance_);
+    std::vector<double>().swap(kept_weight_over_r2_);
 }
 
-NeighbourLists::PairTerms NeighbourLists::keep_pairs(std::size_t real) {
+double* NeighbourLists::keep_pairs(std::size_t real) {
     kept_rows_ = 0;
     if (!keep_allowed_) {
         forget_kept_arrays();
-        return {nullptr, nullptr};
+        return nullptr;
     }
     const std::size_t entries = lists_.offsets[std::min(real, lists_.rows())];
-    if (entries > kept_weight_.capacity()) {  // grown: no copy of the old terms beside the new arrays
-        kept_weight_.clear();
-        kept_inverse_distance_.clear();
-    }
-    resize_with_slack(kept_weight_, entries);
-    resize_with_slack(kept_inverse_distance_, entries);
-    return {kept_weight_.data(), kept_inverse_distance_.data()};
+    if (entries > kept_weight_over_r2_.capacity()) kept_weight_over_r2_.clear();  // grown: no copy of the old terms beside the new array
+    resize_with_slack(kept_weight_over_r2_, entries);
+    return kept_weight_over_r2_.data();
 }
 
 void NeighbourLists::place_ghosts(NodeStore& nodes, std::size_t real, GhostSet& ghosts, InfluenceDistance influence_distance, bool first) {
@@ -337,7 +332,7 @@ void NeighbourLists::read_state(StateReader& in, int dim, std::size_t node_count
 
 void NeighbourLists::memory_use(MemoryUse& out) const {
     add_memory(out, "neighbour lists: lists", allocated_bytes(lists_.indices) + allocated_bytes(lists_.offsets));
-    add_memory(out, "neighbour lists: kept pair terms", allocated_bytes(kept_weight_) + allocated_bytes(kept_inverse_distance_));
+    add_memory(out, "neighbour lists: kept pair terms", allocated_bytes(kept_weight_over_r2_));
     add_memory(out, "neighbour lists: skin candidates", allocated_bytes(candidates_.indices) + allocated_bytes(candidates_.offsets) +
                                                             allocated_bytes(lattice_entries_) + allocated_bytes(keep_scratch_) +
                                                             allocated_bytes(quiet_) + allocated_bytes(searched_fixed_));

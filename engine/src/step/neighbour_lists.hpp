@@ -49,25 +49,20 @@ public:
 
     const CompressedRows& rows() const { return lists_; }
 
-    // Each pair's R_ij and 1 / r_ij for the sweeps of a step (fields.hpp, PairFields::kept_weight):
-    // keep_pairs gives the gradient sweep arrays for the entries of the rows [0, real) to write,
+    // Each pair's R_ij / r_ij^2 for the sweeps of a step (fields.hpp, PairFields::kept_weight_over_r2):
+    // keep_pairs gives the gradient sweep an array for the entries of the rows [0, real) to write,
     // pairs_kept says it has, and with_kept_pairs hands them to the sweeps after it. They are
     // forgotten when the positions move (forget_kept_pairs, the move phase) and when the lists
     // change. Not checkpointed: every step makes them again before it reads them. When the memory
     // limit leaves no room for them (set_entry_check), keep_pairs gives null pointers and the
     // sweeps make the terms themselves.
-    struct PairTerms {
-        double* weight;
-        double* inverse_distance;
-    };
-    PairTerms keep_pairs(std::size_t real);
+    double* keep_pairs(std::size_t real);
     void pairs_kept(std::size_t real) { kept_rows_ = keep_allowed_ ? real : 0; }
     void forget_kept_arrays();
     void forget_kept_pairs() { kept_rows_ = 0; }
     template <int D>
     PairFields<D> with_kept_pairs(PairFields<D> pairs) const {
-        pairs.kept_weight = kept_weight_.data();
-        pairs.kept_inverse_distance = kept_inverse_distance_.data();
+        pairs.kept_weight_over_r2 = kept_weight_over_r2_.data();
         pairs.kept_rows = kept_rows_;
         return pairs;
     }
@@ -128,7 +123,7 @@ private:
     std::array<std::vector<double>, 3> searched_position_;
     std::vector<double> searched_diameter_;
     ScatterPlan plan_;
-    std::vector<double> kept_weight_, kept_inverse_distance_;  // per list entry of the rows [0, kept_rows_)
+    std::vector<double> kept_weight_over_r2_;  // per list entry of the rows [0, kept_rows_)
     std::size_t kept_rows_ = 0;
     bool keep_allowed_ = true;  // the memory limit leaves room for the kept pair terms
 };

@@ -275,9 +275,7 @@ void Simulation::Impl::gradient() {
     f.full_normalisation = scene.solver.normalisation == Normalisation::MomentMatrix;
     f.surface_correction = scene.solver.surface_correction;
     f.allow_degenerate = true;  // a fragment that has lost its neighbours flies on (see fields.hpp)
-    const NeighbourLists::PairTerms kept = neighbour_lists.keep_pairs(real);  // for the sweeps after this one
-    f.keep_weight = kept.weight;
-    f.keep_inverse_distance = kept.inverse_distance;
+    f.keep_weight_over_r2 = neighbour_lists.keep_pairs(real);  // for the sweeps after this one
     compute_velocity_gradient<G>(lists(), scene.solver.weight, f, real);
     neighbour_lists.pairs_kept(std::min(real, lists().rows()));
 }

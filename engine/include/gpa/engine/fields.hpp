@@ -75,48 +75,60 @@ struct PairFields {
     template <class VariableWeight>
     PairGeometry<D> pair(std::size_t i, std::size_t j) const {
         PairGeometry<D> p;
-        Vec<D> dx;
-        for (int c = 0; c < D; ++c) dx[c] = position[c][j] - position[c][i];
-        p.r = dx.norm();
+        p.dx = offset(i, j);
+        p.r = p.dx.norm();
         p.inv_r = 1.0 / p.r;
-        p.l = dx * p.inv_r;
+        p.l = p.dx * p.inv_r;
         p.h = pair_smoothing_length(influence_distance, diameter[i], diameter[j]);
         const double v = p.r / p.h;
         p.R = VariableWeight::value(lattice_pair(i, j) ? std::min(v, lattice_weight_reach) : v);
+        p.R_over_r2 = p.R * p.inv_r * p.inv_r;
         return p;
     }
 
-    // The weights R_ij and inverse distances 1 / r_ij that this step's gradient sweep kept for the
-    // centres [0, kept_rows), one per entry of the lists (NeighbourLists::keep_pairs; entry k of
-    // row i is lists.offsets[i] + k). The sweeps after it in the same step (forces, stress power,
+    // x_j - x_i.
+    Vec<D> offset(std::size_t i, std::size_t j) const {
+        Vec<D> dx;
+        for (int c = 0; c < D; ++c) dx[c] = position[c][j] - position[c][i];
+        return dx;
+    }
+
+    // The unit vector along an offset, the same numbers as pair()'s l: for a kept pair (which
+    // has no l) where a kernel needs the direction itself (a sliding pair's normal).
+    static Vec<D> direction(const Vec<D>& dx) { return dx * (1.0 / dx.norm()); }
+
+    // The terms R_ij / r_ij^2 that this step's gradient sweep kept for the centres [0, kept_rows),
+    // one per entry of the lists (NeighbourLists::keep_pairs; entry k of row i is
+    // lists.offsets[i] + k). The sweeps after it in the same step (forces, stress power,
     // smoothing) read them instead of making the square root, the two divisions and the weight
     // again: positions, diameters, connectivity and bodies do not change between the gradient and
     // the last of these sweeps (the switching phase comes after them), so they are the same numbers
     // bit for bit.
-    const double* kept_weight = nullptr;
-    const double* kept_inverse_distance = nullptr;
+    const double* kept_weight_over_r2 = nullptr;
     std::size_t kept_rows = 0;
 
-    // pair<W>(i, j) of list entry `entry` of centre i, from the kept numbers where there are any.
-    // A kept pair has no r and h (NaN): a kernel that reads them (the bond viscosity, Eq. 38)
-    // calls pair(i, j).
+    // pair<W>(i, j) of list entry `entry` of centre i, from the kept term where there is one. A
+    // kept pair has only dx and R / r^2 (the rest NaN): a kernel that reads r and h (the bond
+    // viscosity, Eq. 38) calls pair(i, j), and one that needs l takes direction(dx).
     template <class VariableWeight>
     PairGeometry<D> pair(std::size_t i, std::size_t j, std::size_t entry) const {
         if (i >= kept_rows) return pair<VariableWeight>(i, j);
         PairGeometry<D> p;
-        Vec<D> dx;
-        for (int c = 0; c < D; ++c) dx[c] = position[c][j] - position[c][i];
-        p.inv_r = kept_inverse_distance[entry];
-        p.l = dx * p.inv_r;
-        p.r = p.h = std::numeric_limits<double>::quiet_NaN();
-        p.R = kept_weight[entry];
+        p.dx = offset(i, j);
+        p.R_over_r2 = kept_weight_over_r2[entry];
+        p.r = p.h = p.inv_r = p.R = std::numeric_limits<double>::quiet_NaN();
+        p.l = Vec<D>::Constant(std::numeric_limits<double>::quiet_NaN());
         return p;
     }
 
-    // R_ij alone (Eq. 1b or 62-65), of list entry `entry` of centre i.
+    // The smoothing's pair weight (Eq. 66-67) of list entry `entry` of centre i: R_ij as
+    // (R / r^2) r^2, from the kept term or made, the same numbers either way (and the same from
+    // either end of the pair).
     template <class VariableWeight>
     double weight(std::size_t i, std::size_t j, std::size_t entry) const {
-        return i < kept_rows ? kept_weight[entry] : pair<VariableWeight>(i, j).R;
+        if (i < kept_rows) return kept_weight_over_r2[entry] * offset(i, j).squaredNorm();
+        const PairGeometry<D> p = pair<VariableWeight>(i, j);
+        return p.R_over_r2 * p.dx.squaredNorm();
     }
 };
 
@@ -139,10 +151,9 @@ struct GradientFields {
     double* smallest_h = nullptr;
     double* stable_length = nullptr;  // optional (kernels.hpp: stable_length)
     double alpha_limit = 0.0;         // > 0: alpha_b <= alpha_limit / W_i
-    // Optional, one per list entry of the centres swept: each pair's R_ij and 1 / r_ij, kept for
-    // the sweeps after the gradient (PairFields::kept_weight).
-    double* keep_weight = nullptr;
-    double* keep_inverse_distance = nullptr;
+    // Optional, one per list entry of the centres swept: each pair's R_ij / r_ij^2, kept for the
+    // sweeps after the gradient (PairFields::kept_weight_over_r2).
+    double* keep_weight_over_r2 = nullptr;
     // false: a centre without neighbours, or whose neighbours give no geometry factor along some
     // axis, is an error (InputError naming it). true (in a run, where fracture and spall leave
     // fragments): its factor along that axis is 0, so it has no strain rate and exerts no force

@@ -29,6 +29,11 @@ struct PairGeometry {
     double inv_r;  // 1 / r (once per pair: the kernels multiply by it instead of dividing)
     double h;      // h_ij (Eq. 2)
     double R;      // distance weight R_ij (Eq. 1a, 1b, or 62-65)
+    Vec<D> dx;     // x_j - x_i = r l
+    // R / r^2: the force and the energy booking use R / r and l together, (R / r) l = (R / r^2) dx,
+    // so this one number per pair is all they need besides the positions (the term the gradient
+    // sweep keeps for them, fields.hpp).
+    double R_over_r2;
 };
 
 // Running sums of the gradient gather for one centre node.
@@ -170,14 +175,15 @@ inline double volumetric_strain_rate(const Mat<G::dim>& L, double radial_velocit
 }
 
 // Eq. 21-22, 54-56: the force that centre i's stress exerts on neighbour j,
-//   P_a(ij) = - R V_i W_j / r * sum_b alpha_b(i) (sigma_ab(i) - Q_ij delta_ab) l_b,
-// given the normalised direction n = N_i l (alpha o l, or M_i^-1 l with the full normalisation
-// of spec section 7). sigma is the in-plane Cauchy stress of i including its nodal viscosity;
-// Q_ij is the bond viscosity (0 without it). The reaction -P(ij) acts on i (Eq. 23-24).
+//   P_a(ij) = - R V_i W_j / r * sum_b alpha_b(i) (sigma_ab(i) - Q_ij delta_ab) l_b
+//           = - (R / r^2) V_i W_j * sum_b alpha_b(i) (sigma_ab(i) - Q_ij delta_ab) dx_b,
+// given the normalised offset n = N_i dx (alpha o dx, or M_i^-1 dx with the full normalisation
+// of spec section 7; dx = r l). sigma is the in-plane Cauchy stress of i including its nodal
+// viscosity; Q_ij is the bond viscosity (0 without it). The reaction -P(ij) acts on i (Eq. 23-24).
 template <int D>
 inline Vec<D> pair_force(const PairGeometry<D>& p, double volume_i, double size_weight_j,
-                         const Vec<D>& normalised_l, const Mat<D>& sigma_i, double bond_q) {
-    return (-p.R * volume_i * size_weight_j * p.inv_r) * (sigma_i * normalised_l - bond_q * normalised_l);
+                         const Vec<D>& normalised_dx, const Mat<D>& sigma_i, double bond_q) {
+    return (-p.R_over_r2 * volume_i * size_weight_j) * (sigma_i * normalised_dx - bond_q * normalised_dx);
 }
 
 // Spec section 5, "[spec] Compatible energy": the work rate of centre i's stress forces at some
@@ -186,11 +192,11 @@ inline Vec<D> pair_force(const PairGeometry<D>& p, double volume_i, double size_
 // -V_i (sigma_i N_i) : B_i with B_i = sum_j (R W_j / r) dv_j l_j^T, the row's sum of velocity
 // differences (D x D; GradientSums::difference, the velocity gradient of Eq. 7-11 before its
 // normalisation, here at v); the nodal viscosity's part -Q_i I of sigma_i gives Q_i V_i N_i : B_i.
-// One pair's share of B_i:
+// One pair's share of B_i, (R W_j / r) dv l^T = (R / r^2) W_j dv dx^T (the form of pair_force):
 template <int D>
 inline void accumulate_velocity_difference(const PairGeometry<D>& p, double size_weight_j, const Vec<D>& dv,
                                            Mat<D>& difference) {
-    difference.noalias() += (p.R * size_weight_j * p.inv_r) * dv * p.l.transpose();
+    difference.noalias() += (p.R_over_r2 * size_weight_j) * dv * p.dx.transpose();
 }
 
 // Spec section 2, "[spec] Sliding contact": a pair across a contact or a crack (a closed separable
@@ -211,16 +217,16 @@ inline double hoop_force(double sigma_theta, double volume, double radius) {
 
 // The stress-difference form (the paper's Eq. 28; docs/surfaces.md): node i's force is V_i times
 // the divergence of the stress at i, estimated with the operator of its strain rates,
-//   F_i = V_i sum_j (R W_j / r) (sigma_j - kept sigma_i) N_i l,
+//   F_i = V_i sum_j (R W_j / r) (sigma_j - kept sigma_i) N_i l = V_i sum_j (R / r^2) W_j (...) N_i dx,
 // one term per neighbour j, kept = 1 - g. g is the one-sidedness of i's neighbourhood
 // (one_sidedness): 0 inside a body, where the form is Eq. 28 and a uniform stress gives no force on
 // any neighbourhood; 1 at a free surface, where the missing side's zero stress completes it into the
 // sum form V_i sum_j (R W_j / r) sigma_j N_i l (a face node of a bar under uniform sigma then
 // feels -A sigma, the traction-free face; Eq. 28 alone would give it nothing).
 template <int D>
-inline Vec<D> stress_difference_term(const PairGeometry<D>& p, double volume_i, double size_weight_j, const Vec<D>& normalised_l,
+inline Vec<D> stress_difference_term(const PairGeometry<D>& p, double volume_i, double size_weight_j, const Vec<D>& normalised_dx,
                                      const Mat<D>& sigma_j, const Mat<D>& kept_sigma_i) {
-    return (p.R * volume_i * size_weight_j * p.inv_r) * ((sigma_j - kept_sigma_i) * normalised_l);
+    return (p.R_over_r2 * volume_i * size_weight_j) * ((sigma_j - kept_sigma_i) * normalised_dx);
 }
 
 // How one-sided a neighbourhood is: along its first moment's direction d (sum_j R W_j l), with p and
