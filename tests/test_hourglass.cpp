@@ -275,6 +275,7 @@ TEST_P(Hourglass, TheBookingPassMakesTheSameForcesFromTheKeptFits) {
             f.power_velocity[c2] = other[c2].data();
         }
         std::size_t kept = 0, without = 0;
+        std::vector<HourglassPower> fitted(n);
         for (std::size_t i = 0; i < n; ++i) {
             const bool controlled = nodes.connectivity[i] == Connectivity::Fixed || nodes.plastic_strain[i] < 0.1;
             if (controlled) {
@@ -289,6 +290,7 @@ TEST_P(Hourglass, TheBookingPassMakesTheSameForcesFromTheKeptFits) {
             reuse.use_kept_fits = true;
             const HourglassPower a_fresh = hourglass_centre<D>(lists.row(i), i, fresh, n, 0.1);
             const HourglassPower a_kept = hourglass_centre<D>(lists.row(i), i, reuse, n, 0.1);
+            fitted[i] = a_fresh;
             ASSERT_EQ(std::memcmp(&a_fresh.damping, &a_kept.damping, sizeof(double)), 0)
                 << "centre " << i << ": " << a_fresh.damping << " fitted again, " << a_kept.damping << " from the kept fit";
             ASSERT_EQ(std::memcmp(&a_fresh.stiffness, &a_kept.stiffness, sizeof(double)), 0)
@@ -303,6 +305,31 @@ TEST_P(Hourglass, TheBookingPassMakesTheSameForcesFromTheKeptFits) {
         EXPECT_GT(kept, 0u);
         if (c.connectivity == Connectivity::Variable) {
             EXPECT_GT(without, 0u);
+        }
+        // The booking pass itself (compute_stress_power) takes the damping's power in its own walk
+        // of each row (KeptDampingPower): the same powers again, bit for bit.
+        auto booking = f;
+        booking.use_kept_fits = true;
+        std::vector<double> booked_damping(n, nan), booked_stiffness(n, nan), stress_power(n), viscous_power(n);
+        booking.power = booked_damping.data();
+        booking.stiffness_power = booked_stiffness.data();
+        const auto forces = force_fields<D>(nodes, a);
+        std::array<const double*, D> w{};
+        for (int c2 = 0; c2 < D; ++c2) w[c2] = other[c2].data();
+        if constexpr (D == 3) {
+            compute_stress_power<ThreeD>(lists, WeightKind::Gpa, forces, w, n, stress_power.data(), viscous_power.data(), &booking, 0.1);
+        } else if (c.geometry == GeometryKind::Axisymmetric) {
+            compute_stress_power<Axisymmetric>(lists, WeightKind::Gpa, forces, w, n, stress_power.data(), viscous_power.data(), &booking,
+                                               0.1);
+        } else {
+            compute_stress_power<PlaneStrain>(lists, WeightKind::Gpa, forces, w, n, stress_power.data(), viscous_power.data(), &booking,
+                                              0.1);
+        }
+        for (std::size_t i = 0; i < n; ++i) {
+            ASSERT_EQ(std::memcmp(&fitted[i].damping, &booked_damping[i], sizeof(double)), 0)
+                << "centre " << i << ": " << fitted[i].damping << " fitted again, " << booked_damping[i] << " from the booking pass";
+            ASSERT_EQ(std::memcmp(&fitted[i].stiffness, &booked_stiffness[i], sizeof(double)), 0)
+                << "centre " << i << ": " << fitted[i].stiffness << " fitted again, " << booked_stiffness[i] << " from the booking pass";
         }
     };
     if (dim == 2) {

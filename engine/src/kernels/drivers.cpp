@@ -361,6 +361,10 @@ void stress_power_impl(const CompressedRows& lists, const ForceFields<G::dim>& f
             // The row's sum of velocity differences B_i (kernels.hpp, accumulate_velocity_difference):
             // power -V_i (sigma_i N_i) : B_i, divergence N_i : B_i, no pair force made.
             Mat<D> difference = Mat<D>::Zero();
+            // The hourglass damping's power in the same walk of the row (hourglass.hpp,
+            // KeptDampingPower): the same numbers as a walk of its own.
+            KeptDampingPower<D> damping;
+            if (hourglass) damping = KeptDampingPower<D>(*hourglass, i, n, hourglass_coefficient);
             const std::size_t first = lists.offsets[i];
             const auto row = lists.row(i);
             for (std::size_t k = 0; k < row.size(); ++k) {
@@ -371,6 +375,7 @@ void stress_power_impl(const CompressedRows& lists, const ForceFields<G::dim>& f
                     dv = along_pair<D>(f.pairs.sliding_normal(i, j, PairFields<D>::direction(p.dx)), dv);  // spec section 2
                 }
                 accumulate_velocity_difference<D>(p, f.size_weight[j], dv, difference);
+                if (damping.active()) damping.add(*hourglass, j, p.dx, n);
             }
             double sum = -volume * (sigma * normalisation).cwiseProduct(difference).sum();  // Eq. 21-22 summed over j
             double divergence = normalisation.cwiseProduct(difference).sum();
@@ -383,9 +388,15 @@ void stress_power_impl(const CompressedRows& lists, const ForceFields<G::dim>& f
             power[i] = sum;
             viscous_power[i] = q * volume * divergence;
             if (hourglass) {
-                const HourglassPower h = hourglass_centre<D>(lists.row(i), i, *hourglass, n, hourglass_coefficient);
-                hourglass->power[i] = h.damping;
-                if (hourglass->stiffness_power) hourglass->stiffness_power[i] = h.stiffness;
+                hourglass->power[i] = damping.power();
+                if (hourglass->stiffness_power) {
+                    // The stiffness form's power (fixed centres only) in a walk of its own: coefficient 0
+                    // leaves the damping out of hourglass_centre.
+                    hourglass->stiffness_power[i] =
+                        hourglass->stiffness > 0.0 && hourglass->connectivity[i] == Connectivity::Fixed
+                            ? hourglass_centre<D>(row, i, *hourglass, n, 0.0).stiffness
+                            : 0.0;
+                }
             }
         }
     });

@@ -64,13 +64,7 @@ HourglassPower hourglass_centre(std::span<const NodeIndex> row, std::size_t i, c
         no_kept_fit(f.stiffness_fit);
         return out;
     }
-    // The pairs the control acts on: a centre's neighbours of its own body, real or ghosts that
-    // continue the body across a symmetry plane (ghosts of rigid planes and of the axis, and other
-    // bodies, take no part, nor do the pairs of a failed node when those separate).
-    const auto controlled_pair = [&](NodeIndex j) {
-        const bool continues = j < real_count || (f.ghost_continues && f.ghost_continues[j - real_count]);
-        return continues && f.body[j] == f.body[i] && !(f.failed && (f.failed[i] || f.failed[j]));
-    };
+    const auto controlled_pair = [&](NodeIndex j) { return controlled_hourglass_pair(f, i, j, real_count); };
     // The stiffness form acts on pairs of two fixed nodes: the lattice pairs, whose initial offsets
     // are the lattice's.
     const auto stiff_pair = [&](NodeIndex j) { return controlled_pair(j) && f.connectivity[j] == Connectivity::Fixed; };
@@ -119,18 +113,11 @@ HourglassPower hourglass_centre(std::span<const NodeIndex> row, std::size_t i, c
     };
     if (coefficient > 0.0 && f.use_kept_fits) {
         // The force pass's fit: its forces again, pair by pair as in pass 2 below, for their power.
-        const double kappa = f.damping_fit.scale[i];
-        if (kappa != 0.0) {
-            const Mat<D> fitted_gradient = kept_matrix(f.damping_fit);
-            for (NodeIndex j : row) {
-                if (!controlled_pair(j)) continue;
-                const Vec<D> r = load(f.position, j) - x_i;
-                const double w = hourglass_pair_weight(f.size_weight[j], r.squaredNorm());
-                const Vec<D> dv = load(f.velocity, j) - v_i;
-                const Vec<D> force_on_j = (-kappa * w) * hourglass_velocity_error<D>(fitted_gradient, r, dv);
-                out.damping += power_of(j, force_on_j, dv);
-            }
+        KeptDampingPower<D> kept(f, i, real_count, coefficient);
+        if (kept.active()) {
+            for (NodeIndex j : row) kept.add(f, j, load(f.position, j) - x_i, real_count);
         }
+        out.damping = kept.power();
     } else if (coefficient > 0.0) {
         // Pass 1: the weighted least-squares velocity gradient of the lattice pairs.
         pairs.clear();

@@ -12,6 +12,7 @@
 
 #include "gpa/engine/colouring.hpp"
 #include "gpa/engine/compressed_rows.hpp"
+#include "gpa/engine/kernels.hpp"
 #include "gpa/engine/node_store.hpp"
 
 namespace gpa {
@@ -93,12 +94,72 @@ struct HourglassPower {
 // The control at one centre i with neighbour row `row` (the per-centre kernel of
 // apply_hourglass_control): adds its forces to f.force when that is set (the caller keeps two
 // centres that share a node from running at once) and returns their powers; zero powers for a
-// centre that is not controlled. Also the energy booking's pass (drivers.hpp,
-// compute_stress_power) calls it, with no force and power_velocity set, so that the step visits
-// each row once for its stress and hourglass work.
+// centre that is not controlled. The energy booking's pass (drivers.hpp, compute_stress_power)
+// takes the damping's power pair by pair in its own walk of the row (KeptDampingPower, below) and
+// calls this, with no force, power_velocity set and coefficient 0, for the stiffness form's.
 template <int D>
 HourglassPower hourglass_centre(std::span<const NodeIndex> row, std::size_t i, const HourglassFields<D>& f,
                                 std::size_t real_count, double coefficient);
+
+// A pair (i, j) the control acts on: j of the centre's own body, real or a ghost that continues the
+// body across a symmetry plane (ghosts of rigid planes and of the axis, and other bodies, take no
+// part, nor do the pairs of a failed node when those separate).
+template <int D>
+inline bool controlled_hourglass_pair(const HourglassFields<D>& f, std::size_t i, std::size_t j, std::size_t real_count) {
+    const bool continues = j < real_count || (f.ghost_continues && f.ghost_continues[j - real_count]);
+    return continues && f.body[j] == f.body[i] && !(f.failed && (f.failed[i] || f.failed[j]));
+}
+
+// The power of one centre's damping forces made again from the force pass's kept fit
+// (use_kept_fits), pair by pair, for a pass that walks the row for sums of its own (the energy
+// booking's, compute_stress_power): F_j = -kappa w_j e_ij (kernels.hpp), its power
+// F_j . (w_j - w_i) at power_velocity. The same numbers, in the same order, as hourglass_centre's
+// own walk of the row, which uses it too.
+template <int D>
+class KeptDampingPower {
+public:
+    KeptDampingPower() = default;
+    // Inactive (every pair adds nothing) for a centre without damping: kept scale 0, i a ghost, or
+    // no damping at all (coefficient 0).
+    KeptDampingPower(const HourglassFields<D>& f, std::size_t i, std::size_t real_count, double coefficient) : i_(i) {
+        if (i >= real_count || !(coefficient > 0.0) || !f.use_kept_fits) return;
+        kappa_ = f.damping_fit.scale[i];
+        if (kappa_ == 0.0) return;
+        for (int a = 0; a < D; ++a) {
+            for (int b = 0; b < D; ++b) fitted_gradient_(a, b) = f.damping_fit.matrix[a * D + b][i];
+        }
+        other_velocity_ = f.power_velocity[0] != nullptr;
+        for (int c = 0; c < D; ++c) {
+            v_i_[c] = f.velocity[c][i];
+            if (other_velocity_) w_i_[c] = f.power_velocity[c][i];
+        }
+    }
+    bool active() const { return kappa_ != 0.0; }
+    // Pair (i, j), r = x_j - x_i; a pair the control does not act on adds nothing.
+    void add(const HourglassFields<D>& f, std::size_t j, const Vec<D>& r, std::size_t real_count) {
+        if (!controlled_hourglass_pair(f, i_, j, real_count)) return;
+        const double w = hourglass_pair_weight(f.size_weight[j], r.squaredNorm());
+        Vec<D> dv;
+        for (int c = 0; c < D; ++c) dv[c] = f.velocity[c][j] - v_i_[c];
+        const Vec<D> force_on_j = (-kappa_ * w) * hourglass_velocity_error<D>(fitted_gradient_, r, dv);
+        if (other_velocity_) {
+            Vec<D> dw;
+            for (int c = 0; c < D; ++c) dw[c] = f.power_velocity[c][j] - w_i_[c];
+            power_ += force_on_j.dot(dw);
+        } else {
+            power_ += force_on_j.dot(dv);
+        }
+    }
+    double power() const { return power_; }
+
+private:
+    std::size_t i_ = 0;
+    double kappa_ = 0.0;
+    bool other_velocity_ = false;
+    Mat<D> fitted_gradient_ = Mat<D>::Zero();
+    Vec<D> v_i_ = Vec<D>::Zero(), w_i_ = Vec<D>::Zero();
+    double power_ = 0.0;
+};
 
 template <int D>
 void apply_hourglass_control(const CompressedRows& lists, const ScatterPlan& plan, const HourglassFields<D>& f,
