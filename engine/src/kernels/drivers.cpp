@@ -132,14 +132,23 @@ void gradient_impl(const CompressedRows& lists, const GradientFields<G::dim>& f,
             bool ok = true;
             const std::size_t first = lists.offsets[i];
             const auto row = lists.row(i);
-            for (std::size_t k = 0; k < row.size(); ++k) {
-                const NodeIndex j = row[k];
-                const auto p = f.pairs.template pair<W>(i, j);
-                ok &= p.r > 0.0;
-                if (keep) f.keep_weight_over_r2[first + k] = p.R_over_r2;
-                Vec<D> dv = load<D>(f.velocity, j) - v_i;
-                if (f.pairs.sliding(i, j)) dv = along_pair<D>(f.pairs.sliding_normal(i, j, p.l), dv);  // spec section 2
-                accumulate_gradient<D, full>(p, f.size_weight[j], dv, sums);
+            // The row's pair geometry a chunk at a time (PairFields::pairs, two pairs per step of
+            // the divider), then summed pair by pair in the row's order.
+            constexpr std::size_t chunk = 32;
+            std::array<PairGeometry<D>, chunk> geometry;
+            for (std::size_t start = 0; start < row.size(); start += chunk) {
+                const std::size_t count = std::min(chunk, row.size() - start);
+                f.pairs.template pairs<W>(i, row.data() + start, count, geometry.data());
+                for (std::size_t c = 0; c < count; ++c) {
+                    const std::size_t k = start + c;
+                    const NodeIndex j = row[k];
+                    const PairGeometry<D>& p = geometry[c];
+                    ok &= p.r > 0.0;
+                    if (keep) f.keep_weight_over_r2[first + k] = p.R_over_r2;
+                    Vec<D> dv = load<D>(f.velocity, j) - v_i;
+                    if (f.pairs.sliding(i, j)) dv = along_pair<D>(f.pairs.sliding_normal(i, j, p.l), dv);  // spec section 2
+                    accumulate_gradient<D, full>(p, f.size_weight[j], dv, sums);
+                }
             }
             if (f.surface_correction) correct_for_surface<G, W, full>(f, row, i, sums);
             Mat<D> normalisation;

@@ -16,10 +16,17 @@ enum class WeightKind {
 // v at which a lattice pair's weight stops falling: R(1.8) = 0.1 for the GPA weight.
 inline constexpr double lattice_weight_reach = 1.8;
 
+// The weights below take a double, or two of them at once as a GCC vector (fields.hpp,
+// PairLanes), for which the comparisons give masks and ?: picks lane by lane; each lane gets the
+// same operations, so the same bits, as the double alone.
+
 // Eq. 1b: R = 1 - v/2 for v = r/h in [0, 2), zero beyond (a neighbour at exactly 2h has weight 0).
 struct GpaWeight {
     static constexpr WeightKind kind = WeightKind::Gpa;
-    static double value(double v) { return v < 2.0 ? 1.0 - 0.5 * v : 0.0; }
+    template <class T>
+    static T value(T v) {
+        return v < 2.0 ? T(1.0 - 0.5 * v) : T{};
+    }
 };
 
 // Eq. 62-65: SPH with normalised smoothing functions is GPA with R = -r dW/dr. For the cubic
@@ -27,13 +34,10 @@ struct GpaWeight {
 // R = 3 q^2 - 9/4 q^3 (q < 1) and R = 3/4 q (2 - q)^2 (1 <= q < 2), up to the kernel's constant.
 struct SphNsfWeight {
     static constexpr WeightKind kind = WeightKind::SphNsf;
-    static double value(double q) {
-        if (q < 1.0) return q * q * (3.0 - 2.25 * q);
-        if (q < 2.0) {
-            const double t = 2.0 - q;
-            return 0.75 * q * t * t;
-        }
-        return 0.0;
+    template <class T>
+    static T value(T q) {
+        const T t = 2.0 - q;
+        return q < 1.0 ? T(q * q * (3.0 - 2.25 * q)) : (q < 2.0 ? T(0.75 * q * t * t) : T{});
     }
 };
 
