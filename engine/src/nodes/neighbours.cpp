@@ -269,17 +269,53 @@ void find_neighbours(const NodeStore& nodes, InfluenceDistance influence, std::s
             }
             return true;
         };
-        const auto scan = [&](const CellGrid& g, std::size_t cells_around) {
+        // Scans the box of cells within cells_around of the centre's for nodes closer than
+        // `distance` (the largest reach of a pair of this centre in g). A cell of the box that lies
+        // wholly beyond that distance holds no pair and is skipped: in 3D the corner cells of the
+        // 5 x 5 x 5 box, about a third of its volume. The skip leaves the order of the rest, so
+        // the lists are the same entry for entry.
+        const auto scan = [&](const CellGrid& g, std::size_t cells_around, double distance) {
             std::array<std::size_t, 3> lo{0, 0, 0}, hi{0, 0, 0};
             box(g, cells_around, lo, hi);
             if (fixed && &g == &grid && quiet_box(lo, hi)) {
                 if (candidates) scratch.quiet[i] = 1;
                 return;
             }
+            // Per axis, the gap from the centre to each cell row of the box (0 where the centre
+            // lies within the row's span), for boxes up to 16 cells across (larger ones, outsized
+            // centres, are scanned whole). The limit carries a margin far above the rounding that
+            // can put a node just outside its cell's span (a billionth of the distance, and 1e-12
+            // of the largest coordinate of the centre and the grid).
+            constexpr std::size_t widest = 16;
+            std::array<std::array<double, widest>, 3> gap;  // rows [0, hi - lo] of each axis set below
+            gap[1][0] = gap[2][0] = 0.0;                     // the single row of an axis beyond dim
+            bool cull = true;
+            double largest_coordinate = 0.0;
+            for (int k = 0; k < dim; ++k) {
+                if (hi[k] - lo[k] + 1 > widest) cull = false;
+                const double far_edge = g.origin[k] + static_cast<double>(g.cells[k]) * g.cell_size;
+                largest_coordinate = std::max({largest_coordinate, std::abs(nodes.position[k][i]), std::abs(g.origin[k]), std::abs(far_edge)});
+            }
+            if (cull) {
+                for (int k = 0; k < dim; ++k) {
+                    const double x = nodes.position[k][i];
+                    for (std::size_t c = lo[k]; c <= hi[k]; ++c) {
+                        const double lower = g.origin[k] + static_cast<double>(c) * g.cell_size;
+                        const double upper = lower + g.cell_size;
+                        gap[static_cast<std::size_t>(k)][c - lo[k]] = x < lower ? lower - x : (x > upper ? x - upper : 0.0);
+                    }
+                }
+            }
+            const double limit = distance * (1.0 + 1e-9) + 1e-12 * largest_coordinate;
+            const double limit2 = limit * limit;
             std::array<std::size_t, 3> c{0, 0, 0};
             for (c[2] = lo[2]; c[2] <= hi[2]; ++c[2]) {
+                const double gz = cull ? gap[2][c[2] - lo[2]] : 0.0;
                 for (c[1] = lo[1]; c[1] <= hi[1]; ++c[1]) {
+                    const double gy = cull ? gap[1][c[1] - lo[1]] : 0.0;
                     for (c[0] = lo[0]; c[0] <= hi[0]; ++c[0]) {
+                        const double gx = cull ? gap[0][c[0] - lo[0]] : 0.0;
+                        if (cull && gx * gx + gy * gy + gz * gz > limit2) continue;
                         const std::size_t cell = g.linear(c);
                         for (std::size_t k = g.cell_start[cell]; k < g.cell_start[cell + 1]; ++k) {
                             const NodeIndex j = g.nodes[k];
@@ -299,12 +335,14 @@ void find_neighbours(const NodeStore& nodes, InfluenceDistance influence, std::s
             }
         };
         if (!split) {
-            scan(grid, span);
+            scan(grid, span, reach);
             return;
         }
         const double d_i = nodes.diameter[i];
-        scan(grid, d_i > spread.cut ? cells_within(grid, a * (d_i + spread.bulk) + skin) : span);
-        scan(scratch.outsized_grid, cells_within(scratch.outsized_grid, a * (d_i + spread.largest) + skin));
+        const double bulk_distance = d_i > spread.cut ? a * (d_i + spread.bulk) + skin : reach;
+        scan(grid, d_i > spread.cut ? cells_within(grid, bulk_distance) : span, bulk_distance);
+        const double outsized_distance = a * (d_i + spread.largest) + skin;
+        scan(scratch.outsized_grid, cells_within(scratch.outsized_grid, outsized_distance), outsized_distance);
     };
 
     // Two passes, count and fill, straight into the output: no per-block buffers, so the peak
