@@ -34,10 +34,39 @@ bool is_pair(const NodeStore& s, double a, std::size_t i, std::size_t j) {
     return within_influence(squared_distance(s, i, j), pair_smoothing_length(a, s.diameter[i], s.diameter[j]));
 }
 
-// r_ij < 2 h_ij + skin: a pair, or one that may become a pair before the next search.
-bool is_candidate(const NodeStore& s, double a, double skin, std::size_t i, std::size_t j) {
-    const double reach = 2.0 * pair_smoothing_length(a, s.diameter[i], s.diameter[j]) + skin;
-    return squared_distance(s, i, j) < reach * reach;
+// Copies the nodes js[0 .. count) that are within reach of centre i (with a skin: candidates,
+// r_ij < 2 h_ij + skin, pairs or nodes that may become pairs before the next search; without:
+// pairs, as is_pair; never i itself) to `within`, in order, and returns how many: the same tests in
+// the same arithmetic, with the dimension fixed at compile time and no branch on their outcome.
+template <int D>
+std::size_t gather_within(const NodeStore& s, double a, double skin, std::size_t i, const NodeIndex* js, std::size_t count,
+                          NodeIndex* within) {
+    std::array<const double*, D> x;
+    for (int c = 0; c < D; ++c) x[c] = s.position[c].data();
+    const double* d = s.diameter.data();
+    std::array<double, D> xi;
+    for (int c = 0; c < D; ++c) xi[c] = x[c][i];
+    const double di = d[i];
+    std::size_t found = 0;
+    for (std::size_t k = 0; k < count; ++k) {
+        const NodeIndex j = js[k];
+        within[found] = j;
+        double r2 = 0.0;
+        for (int c = 0; c < D; ++c) {
+            const double dx = x[c][j] - xi[c];
+            r2 += dx * dx;
+        }
+        const double h = pair_smoothing_length(a, di, d[j]);
+        bool near;
+        if (skin > 0.0) {
+            const double reach = 2.0 * h + skin;
+            near = r2 < reach * reach;
+        } else {
+            near = within_influence(r2, h);  // is_pair
+        }
+        found += static_cast<std::size_t>(near & (j != i));
+    }
+    return found;
 }
 
 }  // namespace
@@ -325,13 +354,9 @@ void find_neighbours(const NodeStore& nodes, InfluenceDistance influence, std::s
                         const std::size_t end = g.cell_start[cell + 1];
                         for (std::size_t k = g.cell_start[cell]; k < end;) {
                             const std::size_t stop = std::min(end, k + within.size());
-                            std::size_t found = 0;
-                            for (; k < stop; ++k) {
-                                const NodeIndex j = g.nodes[k];
-                                within[found] = j;
-                                const bool near = skin > 0.0 ? is_candidate(nodes, a, skin, i, j) : is_pair(nodes, a, i, j);
-                                found += static_cast<std::size_t>(near & (j != i));
-                            }
+                            const std::size_t found = dim == 2 ? gather_within<2>(nodes, a, skin, i, &g.nodes[k], stop - k, within.data())
+                                                               : gather_within<3>(nodes, a, skin, i, &g.nodes[k], stop - k, within.data());
+                            k = stop;
                             for (std::size_t h = 0; h < found; ++h) {
                                 const NodeIndex j = within[h];
                                 if (fixed && nodes.body[j] == own_body) {
