@@ -90,13 +90,18 @@ HourglassPower hourglass_centre(std::span<const NodeIndex> row, std::size_t i, c
         return invertible && fit.weight > 0.0;
     };
     // The controlled pairs of the row with their offsets and weights, found once for the fit and
-    // used again for the forces (a buffer per thread, reused from centre to centre).
+    // used again for the forces: a buffer per thread, reused from centre to centre and sized for
+    // the row before the fit's loop, which then calls nothing (a push_back's possible reallocation
+    // made the compiler keep the fit's sums in memory, a store and a load per sum and pair).
     struct Pair {
         NodeIndex j;
         Vec<D> offset;  // r = x_j - x_i (damping) or dX = X_j - X_i (stiffness)
         double weight;  // w = W_j / r^2 (damping) or 1 / |dX|^2 (stiffness)
     };
-    thread_local std::vector<Pair> pairs;
+    thread_local std::vector<Pair> buffer;
+    if (buffer.size() < row.size()) buffer.resize(row.size());
+    Pair* const pairs = buffer.data();
+    std::size_t count = 0;
     const auto keep = [&](const typename HourglassFields<D>::KeptFit& kept, double scale, const Mat<D>& matrix) {
         if (!kept.scale) return;
         kept.scale[i] = scale;
@@ -120,14 +125,14 @@ HourglassPower hourglass_centre(std::span<const NodeIndex> row, std::size_t i, c
         out.damping = kept.power();
     } else if (coefficient > 0.0) {
         // Pass 1: the weighted least-squares velocity gradient of the lattice pairs.
-        pairs.clear();
         HourglassFit<D> fit;
+        count = 0;
         for (NodeIndex j : row) {
             if (!controlled_pair(j)) continue;
             const Vec<D> r = load(f.position, j) - x_i;
             const double w = hourglass_pair_weight(f.size_weight[j], r.squaredNorm());
             accumulate_hourglass_fit<D>(r, load(f.velocity, j) - v_i, w, fit);
-            pairs.push_back({j, r, w});
+            pairs[count++] = {j, r, w};
         }
         Mat<D> inverse;
         no_kept_fit(f.damping_fit);
@@ -136,7 +141,8 @@ HourglassPower hourglass_centre(std::span<const NodeIndex> row, std::size_t i, c
             const double kappa = hourglass_damping(coefficient, f.mass[i], f.sound_speed[i], f.smallest_h[i]) / fit.weight;
             keep(f.damping_fit, kappa, fitted_gradient);
             // Pass 2: F_j = - kappa w_j e_ij on the neighbour, the reaction on the centre.
-            for (const Pair& p : pairs) {
+            for (std::size_t k = 0; k < count; ++k) {
+                const Pair& p = pairs[k];
                 const Vec<D> dv = load(f.velocity, p.j) - v_i;
                 const Vec<D> force_on_j = (-kappa * p.weight) * hourglass_velocity_error<D>(fitted_gradient, p.offset, dv);
                 if (scatter) {
@@ -164,14 +170,14 @@ HourglassPower hourglass_centre(std::span<const NodeIndex> row, std::size_t i, c
         // The stiffness form (kernels.hpp, hourglass_stiffness): the affine map of the initial
         // lattice pairs that fits their current offsets best, then forces against the rest.
         const Vec<D> x0_i = load(f.initial_position, i);
-        pairs.clear();
         HourglassFit<D> fit;
+        count = 0;
         for (NodeIndex j : row) {
             if (!stiff_pair(j)) continue;
             const Vec<D> initial = load(f.initial_position, j) - x0_i;
             const double w = hourglass_pair_weight(1.0, initial.squaredNorm());
             accumulate_hourglass_fit<D>(initial, load(f.position, j) - x_i, w, fit);
-            pairs.push_back({j, initial, w});
+            pairs[count++] = {j, initial, w};
         }
         Mat<D> inverse;
         no_kept_fit(f.stiffness_fit);
@@ -179,7 +185,8 @@ HourglassPower hourglass_centre(std::span<const NodeIndex> row, std::size_t i, c
             const Mat<D> fitted_map = fit.difference * inverse;
             const double k = hourglass_stiffness(f.stiffness, f.mass[i], f.sound_speed[i], f.initial_diameter[i]) / fit.weight;
             keep(f.stiffness_fit, k, fitted_map);
-            for (const Pair& p : pairs) {
+            for (std::size_t e = 0; e < count; ++e) {
+                const Pair& p = pairs[e];
                 const Vec<D> force_on_j = (-k * p.weight) *
                                           hourglass_displacement_error<D>(fitted_map, p.offset, load(f.position, p.j) - x_i);
                 if (scatter) {
