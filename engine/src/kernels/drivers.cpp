@@ -374,6 +374,7 @@ void stress_power_impl(const CompressedRows& lists, const ForceFields<G::dim>& f
             // KeptDampingPower): the same numbers as a walk of its own.
             KeptDampingPower<D> damping;
             if (hourglass) damping = KeptDampingPower<D>(*hourglass, i, n, hourglass_coefficient);
+            double damping_power = 0.0;
             const std::size_t first = lists.offsets[i];
             const auto row = lists.row(i);
             for (std::size_t k = 0; k < row.size(); ++k) {
@@ -384,7 +385,7 @@ void stress_power_impl(const CompressedRows& lists, const ForceFields<G::dim>& f
                     dv = along_pair<D>(f.pairs.sliding_normal(i, j, PairFields<D>::direction(p.dx)), dv);  // spec section 2
                 }
                 accumulate_velocity_difference<D>(p, f.size_weight[j], dv, difference);
-                if (damping.active()) damping.add(*hourglass, j, p.dx, n);
+                if (damping.active()) damping_power += damping.term(*hourglass, j, p.dx, n);
             }
             double sum = -volume * (sigma * normalisation).cwiseProduct(difference).sum();  // Eq. 21-22 summed over j
             double divergence = normalisation.cwiseProduct(difference).sum();
@@ -397,7 +398,7 @@ void stress_power_impl(const CompressedRows& lists, const ForceFields<G::dim>& f
             power[i] = sum;
             viscous_power[i] = q * volume * divergence;
             if (hourglass) {
-                hourglass->power[i] = damping.power();
+                hourglass->power[i] = damping_power;
                 if (hourglass->stiffness_power) {
                     // The stiffness form's power (fixed centres only) in a walk of its own: coefficient 0
                     // leaves the damping out of hourglass_centre.

@@ -118,11 +118,10 @@ HourglassPower hourglass_centre(std::span<const NodeIndex> row, std::size_t i, c
     };
     if (coefficient > 0.0 && f.use_kept_fits) {
         // The force pass's fit: its forces again, pair by pair as in pass 2 below, for their power.
-        KeptDampingPower<D> kept(f, i, real_count, coefficient);
+        const KeptDampingPower<D> kept(f, i, real_count, coefficient);
         if (kept.active()) {
-            for (NodeIndex j : row) kept.add(f, j, load(f.position, j) - x_i, real_count);
+            for (NodeIndex j : row) out.damping += kept.term(f, j, load(f.position, j) - x_i, real_count);
         }
-        out.damping = kept.power();
     } else if (coefficient > 0.0) {
         // Pass 1: the weighted least-squares velocity gradient of the lattice pairs.
         HourglassFit<D> fit;

@@ -111,7 +111,7 @@ inline bool controlled_hourglass_pair(const HourglassFields<D>& f, std::size_t i
 }
 
 // The power of one centre's damping forces made again from the force pass's kept fit
-// (use_kept_fits), pair by pair, for a pass that walks the row for sums of its own (the energy
+// (use_kept_fits), pair by pair (term), for a pass that walks the row for sums of its own (the energy
 // booking's, compute_stress_power): F_j = -kappa w_j e_ij (kernels.hpp), its power
 // F_j . (w_j - w_i) at power_velocity. The same numbers, in the same order, as hourglass_centre's
 // own walk of the row, which uses it too.
@@ -135,9 +135,11 @@ public:
         }
     }
     bool active() const { return kappa_ != 0.0; }
-    // Pair (i, j), r = x_j - x_i; a pair the control does not act on adds nothing.
-    void add(const HourglassFields<D>& f, std::size_t j, const Vec<D>& r, std::size_t real_count) {
-        if (!controlled_hourglass_pair(f, i_, j, real_count)) return;
+    // The power of pair (i, j), r = x_j - x_i, for the caller to sum over the row in its order
+    // (its sum in a local of the caller's loop, not in this object's memory); 0 for a pair the
+    // control does not act on (a sum that starts at +0 is never -0, so adding +0 changes no bit).
+    double term(const HourglassFields<D>& f, std::size_t j, const Vec<D>& r, std::size_t real_count) const {
+        if (!controlled_hourglass_pair(f, i_, j, real_count)) return 0.0;
         // The velocity differences in scalars, component by component, with Eigen's own product for
         // L r and a dot product summed first to last, as in hourglass_centre (kernels.hpp,
         // hourglass_velocity_error): a 3D vector gathered into Eigen's packets here went through
@@ -153,9 +155,8 @@ public:
             const double dw = other_velocity_ ? f.power_velocity[a][j] - w_i_[a] : dv;
             power = a == 0 ? force_on_j * dw : power + force_on_j * dw;
         }
-        power_ += power;
+        return power;
     }
-    double power() const { return power_; }
 
 private:
     std::size_t i_ = 0;
@@ -163,7 +164,6 @@ private:
     bool other_velocity_ = false;
     Mat<D> fitted_gradient_ = Mat<D>::Zero();
     Vec<D> v_i_ = Vec<D>::Zero(), w_i_ = Vec<D>::Zero();
-    double power_ = 0.0;
 };
 
 template <int D>
