@@ -427,36 +427,51 @@ void filter_rows(const NodeStore& nodes, double a, const CompressedRows& candida
     // when r_ij < 2 h_ij and it is not a pair of two fixed nodes of one body.
     const Connectivity* mode = nodes.connectivity.data();
     const std::int32_t* body = nodes.body.data();
+    const std::size_t* candidate_offsets = candidates.offsets.data();
+    const std::uint32_t* lattice_counts = lattice_entries.data();
+    std::size_t* counts = out.offsets.data();
+    std::uint8_t* keep_out = keep.data();
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rows, filter_block), [&](const tbb::blocked_range<std::size_t>& r) {
+        // The pointers and a as locals of the task: the flags are bytes, whose stores may alias
+        // anything the task reads through its captures, so the loop would load them again after
+        // every flag it writes.
+        const std::array<const double*, D> xs = x;
+        const double* const ds = d;
+        const NodeIndex* const js = index;
+        const Connectivity* const modes = mode;
+        const std::int32_t* const bodies = body;
+        std::uint8_t* const flags = keep_out;
+        const double influence = a;
         for (std::size_t i = r.begin(); i != r.end(); ++i) {
-            const std::size_t first = candidates.offsets[i], last = candidates.offsets[i + 1];
-            const std::size_t lattice_end = std::min(last, first + lattice_entries[i]);
-            const bool fixed_centre = mode[i] == Connectivity::Fixed;
+            const std::size_t first = candidate_offsets[i], last = candidate_offsets[i + 1];
+            const std::size_t lattice_end = std::min(last, first + lattice_counts[i]);
+            const bool fixed_centre = modes[i] == Connectivity::Fixed;
             std::array<double, D> xi;
-            for (int c = 0; c < D; ++c) xi[c] = x[c][i];
-            const double di = d[i];
+            for (int c = 0; c < D; ++c) xi[c] = xs[c][i];
+            const double di = ds[i];
+            const std::int32_t body_i = bodies[i];
             std::size_t kept = 0;
             for (std::size_t e = first; e < last; ++e) {
-                const NodeIndex j = index[e];
-                const bool both_fixed = fixed_centre && mode[j] == Connectivity::Fixed;
+                const NodeIndex j = js[e];
+                const bool both_fixed = fixed_centre && modes[j] == Connectivity::Fixed;
                 bool pair;
                 if (e < lattice_end && both_fixed) {
                     pair = true;
-                } else if (both_fixed && body[j] == body[i]) {
+                } else if (both_fixed && bodies[j] == body_i) {
                     pair = false;
                 } else {
                     double r2 = 0.0;
                     for (int c = 0; c < D; ++c) {
-                        const double dx = x[c][j] - xi[c];
+                        const double dx = xs[c][j] - xi[c];
                         r2 += dx * dx;
                     }
                     // The search's rule, within_influence(r^2, h_ij) (weights.hpp).
-                    pair = within_influence(r2, pair_smoothing_length(a, di, d[j]));
+                    pair = within_influence(r2, pair_smoothing_length(influence, di, ds[j]));
                 }
-                keep[e] = pair;
+                flags[e] = pair;
                 kept += pair;
             }
-            out.offsets[i + 1] = kept;
+            counts[i + 1] = kept;
         }
     });
     for (std::size_t i = 0; i < rows; ++i) out.offsets[i + 1] += out.offsets[i];
