@@ -48,7 +48,25 @@ std::size_t gather_within(const NodeStore& s, double a, double skin, std::size_t
     for (int c = 0; c < D; ++c) xi[c] = x[c][i];
     const double di = d[i];
     std::size_t found = 0;
-    for (std::size_t k = 0; k < count; ++k) {
+    std::size_t k = 0;
+    // Two nodes at a time in the lanes of a GCC vector (each lane the arithmetic of the loop
+    // below), then the rest one by one.
+    using Lanes = double __attribute__((vector_size(16)));
+    for (; k + 2 <= count; k += 2) {
+        const NodeIndex j0 = js[k], j1 = js[k + 1];
+        Lanes r2 = Lanes{0.0, 0.0};
+        for (int c = 0; c < D; ++c) {
+            const Lanes dx = Lanes{x[c][j0], x[c][j1]} - xi[c];
+            r2 += dx * dx;
+        }
+        const Lanes h = pair_smoothing_length(a, Lanes{di, di}, Lanes{d[j0], d[j1]});
+        const auto near = skin > 0.0 ? (r2 < (2.0 * h + skin) * (2.0 * h + skin)) : (r2 < 4.0 * h * h);
+        within[found] = j0;
+        found += static_cast<std::size_t>((near[0] != 0) & (j0 != i));
+        within[found] = j1;
+        found += static_cast<std::size_t>((near[1] != 0) & (j1 != i));
+    }
+    for (; k < count; ++k) {
         const NodeIndex j = js[k];
         within[found] = j;
         double r2 = 0.0;

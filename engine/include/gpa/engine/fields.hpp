@@ -150,7 +150,7 @@ struct PairFields {
         const Lanes r{std::sqrt(r2[0]), std::sqrt(r2[1])};
 #endif
         const Lanes inv_r = 1.0 / r;
-        const Lanes h = influence_distance * 0.5 * (diameter[i] + Lanes{diameter[j0], diameter[j1]});
+        const Lanes h = pair_smoothing_length(influence_distance, Lanes{diameter[i], diameter[i]}, Lanes{diameter[j0], diameter[j1]});
         Lanes v = r / h;
         if (lattice_pair(i, j0)) v[0] = std::min(v[0], lattice_weight_reach);
         if (lattice_pair(i, j1)) v[1] = std::min(v[1], lattice_weight_reach);

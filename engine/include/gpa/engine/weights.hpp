@@ -53,7 +53,9 @@ decltype(auto) dispatch_weight(WeightKind kind, F&& f) {
 inline bool within_influence(double r_squared, double h) { return r_squared < 4.0 * h * h; }
 
 // Eq. 2: h_ij = a (d_i + d_j) / 2.
-inline double pair_smoothing_length(double influence_distance, double d_i, double d_j) {
+// (Also on two pairs at once, T a GCC vector of diameters: fields.hpp, neighbours.cpp.)
+template <class T>
+inline T pair_smoothing_length(double influence_distance, T d_i, T d_j) {
     return influence_distance * 0.5 * (d_i + d_j);
 }
 
