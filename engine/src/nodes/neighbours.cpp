@@ -179,8 +179,12 @@ double bulk_interaction_radius(const NodeStore& nodes, double a, std::size_t cou
 std::array<std::size_t, 3> CellGrid::cell_of(const NodeStore& store, std::size_t i) const {
     std::array<std::size_t, 3> c{0, 0, 0};
     for (int k = 0; k < dim; ++k) {
-        const double f = std::floor((store.position[k][i] - origin[k]) / cell_size);
-        c[k] = f <= 0.0 ? 0 : std::min(cells[k] - 1, static_cast<std::size_t>(f));
+        // The cell floor((x - origin) / edge), clamped to the grid: for a positive quotient the
+        // conversion's truncation is the floor, without floor's own tests and branches (the
+        // baseline x86-64 build has no rounding instruction; the search calls this for every node).
+        const double f = (store.position[k][i] - origin[k]) / cell_size;
+        const double last = static_cast<double>(cells[k] - 1);
+        c[k] = !(f > 0.0) ? 0 : (f >= last ? cells[k] - 1 : static_cast<std::size_t>(f));
     }
     return c;
 }
