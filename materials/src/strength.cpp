@@ -9,24 +9,6 @@
 namespace gpa::materials {
 namespace detail {
 
-// Sym3 (xx, yy, zz, yz, xz, xy) as a symmetric 3x3 matrix (header: Sym3).
-Eigen::Matrix3d to_matrix(const Sym3& s) {
-    Eigen::Matrix3d m;
-    m << s[0], s[5], s[4],  //
-        s[5], s[1], s[3],   //
-        s[4], s[3], s[2];
-    return m;
-}
-
-// Symmetric part of m as Sym3 (xx, yy, zz, yz, xz, xy) (header: Sym3).
-Sym3 to_sym3(const Eigen::Matrix3d& m) {
-    return {m(0, 0), m(1, 1), m(2, 2), 0.5 * (m(1, 2) + m(2, 1)), 0.5 * (m(0, 2) + m(2, 0)),
-            0.5 * (m(0, 1) + m(1, 0))};
-}
-
-// Von Mises equivalent stress sqrt(3/2 s:s) of a deviator s (materials.md, "Strength").
-double von_mises(const Eigen::Matrix3d& deviator) { return std::sqrt(1.5 * deviator.squaredNorm()); }
-
 namespace {
 
 // The thermal factor 1 - T*^m for T* in [0, 1). pow(0, m) = 0: the call is skipped there (room
