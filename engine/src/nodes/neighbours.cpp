@@ -34,55 +34,46 @@ bool is_pair(const NodeStore& s, double a, std::size_t i, std::size_t j) {
     return within_influence(squared_distance(s, i, j), pair_smoothing_length(a, s.diameter[i], s.diameter[j]));
 }
 
-// Copies the nodes js[0 .. count) that are within reach of centre i (with a skin: candidates,
-// r_ij < 2 h_ij + skin, pairs or nodes that may become pairs before the next search; without:
-// pairs, as is_pair; never i itself) to `within`, in order, and returns how many: the same tests in
-// the same arithmetic, with the dimension fixed at compile time and no branch on their outcome.
+// The search's test for the pairs (i, j0) and (i, j1) at once, in the lanes of a GCC vector, each
+// lane the arithmetic of is_pair (skin 0: r_ij < 2 h_ij, within_influence) or of the candidate
+// rule (r_ij < 2 h_ij + skin: pairs, or nodes that may become pairs before the next search).
+template <int D>
+std::array<bool, 2> within_reach(const std::array<const double*, D>& x, const double* d, const std::array<double, D>& xi, double di,
+                                 double a, double skin, NodeIndex j0, NodeIndex j1) {
+    using Lanes = double __attribute__((vector_size(16)));
+    Lanes r2 = Lanes{0.0, 0.0};
+    for (int c = 0; c < D; ++c) {
+        const Lanes dx = Lanes{x[c][j0], x[c][j1]} - xi[c];
+        r2 += dx * dx;
+    }
+    const Lanes h = pair_smoothing_length(a, Lanes{di, di}, Lanes{d[j0], d[j1]});
+    const Lanes reach = 2.0 * h + skin;
+    const auto near = skin > 0.0 ? (r2 < reach * reach) : (r2 < 4.0 * h * h);
+    return {near[0] != 0, near[1] != 0};
+}
+
+// Copies the nodes js[0 .. count) within reach of centre i (within_reach; never i itself) to
+// `within`, in order, and returns how many: the dimension fixed at compile time, two nodes at a
+// time (an odd last node takes both lanes and its second is dropped), no branch on the outcome.
 template <int D>
 std::size_t gather_within(const NodeStore& s, double a, double skin, std::size_t i, const NodeIndex* js, std::size_t count,
                           NodeIndex* within) {
     std::array<const double*, D> x;
     for (int c = 0; c < D; ++c) x[c] = s.position[c].data();
-    const double* d = s.diameter.data();
     std::array<double, D> xi;
     for (int c = 0; c < D; ++c) xi[c] = x[c][i];
-    const double di = d[i];
+    const double* d = s.diameter.data();
     std::size_t found = 0;
-    std::size_t k = 0;
-    // Two nodes at a time in the lanes of a GCC vector (each lane the arithmetic of the loop
-    // below), then the rest one by one.
-    using Lanes = double __attribute__((vector_size(16)));
-    for (; k + 2 <= count; k += 2) {
-        const NodeIndex j0 = js[k], j1 = js[k + 1];
-        Lanes r2 = Lanes{0.0, 0.0};
-        for (int c = 0; c < D; ++c) {
-            const Lanes dx = Lanes{x[c][j0], x[c][j1]} - xi[c];
-            r2 += dx * dx;
-        }
-        const Lanes h = pair_smoothing_length(a, Lanes{di, di}, Lanes{d[j0], d[j1]});
-        const auto near = skin > 0.0 ? (r2 < (2.0 * h + skin) * (2.0 * h + skin)) : (r2 < 4.0 * h * h);
+    for (std::size_t k = 0; k < count; k += 2) {
+        const bool second = k + 1 < count;
+        const NodeIndex j0 = js[k], j1 = second ? js[k + 1] : j0;
+        const auto near = within_reach<D>(x, d, xi, d[i], a, skin, j0, j1);
         within[found] = j0;
-        found += static_cast<std::size_t>((near[0] != 0) & (j0 != i));
-        within[found] = j1;
-        found += static_cast<std::size_t>((near[1] != 0) & (j1 != i));
-    }
-    for (; k < count; ++k) {
-        const NodeIndex j = js[k];
-        within[found] = j;
-        double r2 = 0.0;
-        for (int c = 0; c < D; ++c) {
-            const double dx = x[c][j] - xi[c];
-            r2 += dx * dx;
+        found += static_cast<std::size_t>(near[0] & (j0 != i));
+        if (second) {
+            within[found] = j1;
+            found += static_cast<std::size_t>(near[1] & (j1 != i));
         }
-        const double h = pair_smoothing_length(a, di, d[j]);
-        bool near;
-        if (skin > 0.0) {
-            const double reach = 2.0 * h + skin;
-            near = r2 < reach * reach;
-        } else {
-            near = within_influence(r2, h);  // is_pair
-        }
-        found += static_cast<std::size_t>(near & (j != i));
     }
     return found;
 }

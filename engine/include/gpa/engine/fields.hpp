@@ -135,8 +135,9 @@ struct PairFields {
         return p;
     }
 
-    // pair() of (i, j0) and (i, j1) in the two lanes of GCC vectors: each lane takes pair()'s
-    // operations in pair()'s order (Eigen's squared norm sums the components first to last).
+    // pair() of (i, j0) and (i, j1) (r, l, h_ij of Eq. 2, R of Eq. 1b or 62-65) in the two lanes
+    // of GCC vectors: each lane takes pair()'s operations in pair()'s order (Eigen's squared norm
+    // sums the components first to last).
     template <class VariableWeight>
     void two_pairs(std::size_t i, std::size_t j0, std::size_t j1, PairGeometry<D>* out) const {
         using Lanes = double __attribute__((vector_size(16)));

@@ -17,8 +17,8 @@ enum class WeightKind {
 inline constexpr double lattice_weight_reach = 1.8;
 
 // The weights below take a double, or two of them at once as a GCC vector (fields.hpp,
-// PairLanes), for which the comparisons give masks and ?: picks lane by lane; each lane gets the
-// same operations, so the same bits, as the double alone.
+// PairFields::two_pairs), for which the comparisons give masks and ?: picks lane by lane; each
+// lane gets the same operations, so the same bits, as the double alone.
 
 // Eq. 1b: R = 1 - v/2 for v = r/h in [0, 2), zero beyond (a neighbour at exactly 2h has weight 0).
 struct GpaWeight {
