@@ -16,6 +16,20 @@
 
 namespace gpa {
 
+namespace {
+
+// Ghost k of [first, last) takes its source's value: field[real + k] = field[source[k]].
+template <class T>
+void copy_to_ghosts(T* field, const NodeIndex* source, std::size_t real_count, std::size_t first, std::size_t last) {
+    for (std::size_t k = first; k != last; ++k) field[real_count + k] = field[source[k]];
+}
+
+std::array<double*, 3> vector_field(std::array<std::vector<double>, 3>& field) {
+    return {field[0].data(), field[1].data(), field[2].data()};
+}
+
+}  // namespace
+
 void mirror_stress(int dim, int axis, std::array<double, 6>& s) {
     if (dim == 2) {
         s[2] = -s[2];  // xz: one index along x or along z, whichever the normal is
@@ -217,53 +231,52 @@ void GhostSet::update(NodeStore& nodes, std::size_t real_count) const {
     if (nodes.size() != real_count + ghosts) {
         throw NumericalError(fmt::format("GhostSet::update: {} nodes for {} real and {} ghosts", nodes.size(), real_count, ghosts));
     }
+    // Field by field, each copied in a loop of its own (copy_to_ghosts): one loop over every field
+    // would load each field's address again after every byte it stores (a byte may alias anything).
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, ghosts, 2048), [&](const tbb::blocked_range<std::size_t>& r) {
-        for (std::size_t k = r.begin(); k != r.end(); ++k) {
-            const std::size_t g = real_count + k, s = source_[k];
-            std::array<double, 3> x{0, 0, 0}, v{0, 0, 0}, x0{0, 0, 0};
-            for (int c = 0; c < dim; ++c) {
-                x[c] = nodes.position[c][s];
-                v[c] = nodes.velocity[c][s];
-                x0[c] = nodes.initial_position[c][s];
-            }
-            for (std::size_t p = 0; p < planes_.size(); ++p) {
-                if (!((mask_[k] >> p) & 1u)) continue;
-                planes_[p].reflect_point(x);
-                planes_[p].reflect_vector(v);
-                planes_[p].reflect_point(x0);
-            }
-            for (int c = 0; c < dim; ++c) {
-                nodes.position[c][g] = x[c];
-                nodes.velocity[c][g] = v[c];
-                nodes.initial_position[c][g] = x0[c];
-            }
-            nodes.mass[g] = nodes.mass[s];
-            nodes.volume[g] = nodes.volume[s];
-            nodes.initial_volume[g] = nodes.initial_volume[s];
-            nodes.size_weight[g] = nodes.size_weight[s];  // a ghost across the axis keeps its source's A_j > 0
-            nodes.diameter[g] = nodes.diameter[s];
-            nodes.initial_diameter[g] = nodes.initial_diameter[s];
-            nodes.connectivity[g] = nodes.connectivity[s];
-            nodes.body[g] = nodes.body[s];
-            nodes.id[g] = nodes.id[s];
-            nodes.material[g] = nodes.material[s];
-            nodes.failed[g] = nodes.failed[s];
-        }
+        mirror_to_ghosts(vector_field(nodes.position), dim, real_count, r.begin(), r.end(), Mirrored::Point);
+        mirror_to_ghosts(vector_field(nodes.velocity), dim, real_count, r.begin(), r.end(), Mirrored::Vector);
+        mirror_to_ghosts(vector_field(nodes.initial_position), dim, real_count, r.begin(), r.end(), Mirrored::Point);
+        const NodeIndex* source = source_.data();
+        copy_to_ghosts(nodes.mass.data(), source, real_count, r.begin(), r.end());
+        copy_to_ghosts(nodes.volume.data(), source, real_count, r.begin(), r.end());
+        copy_to_ghosts(nodes.initial_volume.data(), source, real_count, r.begin(), r.end());
+        copy_to_ghosts(nodes.size_weight.data(), source, real_count, r.begin(), r.end());  // across the axis A_j > 0 stays
+        copy_to_ghosts(nodes.diameter.data(), source, real_count, r.begin(), r.end());
+        copy_to_ghosts(nodes.initial_diameter.data(), source, real_count, r.begin(), r.end());
+        copy_to_ghosts(nodes.connectivity.data(), source, real_count, r.begin(), r.end());
+        copy_to_ghosts(nodes.body.data(), source, real_count, r.begin(), r.end());
+        copy_to_ghosts(nodes.id.data(), source, real_count, r.begin(), r.end());
+        copy_to_ghosts(nodes.material.data(), source, real_count, r.begin(), r.end());
+        copy_to_ghosts(nodes.failed.data(), source, real_count, r.begin(), r.end());
     });
 }
 
 void GhostSet::mirror_vector_field(const std::array<double*, 3>& field, int dim, std::size_t real_count) const {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, source_.size(), 2048), [&](const tbb::blocked_range<std::size_t>& r) {
-        for (std::size_t k = r.begin(); k != r.end(); ++k) {
-            const std::size_t g = real_count + k, s = source_[k];
-            std::array<double, 3> v{0, 0, 0};
-            for (int c = 0; c < dim; ++c) v[c] = field[c][s];
-            for (std::size_t p = 0; p < planes_.size(); ++p) {
-                if ((mask_[k] >> p) & 1u) planes_[p].reflect_vector(v);
-            }
-            for (int c = 0; c < dim; ++c) field[c][g] = v[c];
-        }
+        mirror_to_ghosts(field, dim, real_count, r.begin(), r.end(), Mirrored::Vector);
     });
+}
+
+void GhostSet::mirror_to_ghosts(const std::array<double*, 3>& field, int dim, std::size_t real_count, std::size_t first,
+                                std::size_t last, Mirrored kind) const {
+    const std::array<double*, 3> f = field;  // the addresses in registers, not reloaded after each store
+    const NodeIndex* source = source_.data();
+    const std::uint8_t* mask = mask_.data();
+    for (std::size_t k = first; k != last; ++k) {
+        const std::size_t s = source[k];
+        std::array<double, 3> x{0, 0, 0};
+        for (int c = 0; c < dim; ++c) x[c] = f[c][s];
+        for (std::size_t p = 0; p < planes_.size(); ++p) {
+            if (!((mask[k] >> p) & 1u)) continue;
+            if (kind == Mirrored::Point) {
+                planes_[p].reflect_point(x);
+            } else {
+                planes_[p].reflect_vector(x);
+            }
+        }
+        for (int c = 0; c < dim; ++c) f[c][real_count + k] = x[c];
+    }
 }
 
 GhostReach GhostSet::pair_reach(const NodeStore& nodes, std::size_t real_count, double influence_distance, double margin) const {
@@ -356,41 +369,47 @@ double GhostSet::mirrored_displacement_bound(const NodeStore& nodes, std::size_t
 void GhostSet::refresh(NodeStore& nodes, std::size_t real_count) const {
     const int dim = nodes.dim();
     const int comps = stress_components(dim);
+    // The normalisation is a symmetric tensor too. Across an aligned plane its diagonal (alpha) is
+    // unchanged and its off-diagonal entries (alpha_shear) flip like the shear stresses. Across an
+    // oblique one it is H A H; the per-direction normalisation, which keeps the diagonal only (its
+    // alpha_shear is zero), takes the diagonal of H A H: the frame-dependence of that normalisation
+    // (docs/orientation.md, "Oblique planes in the step").
+    const int first_shear = dim == 2 ? 2 : 3, shears = dim == 2 ? 1 : 3;
+    std::array<double*, 6> stress{}, normalisation{};
+    for (int c = 0; c < comps; ++c) stress[c] = nodes.deviatoric_stress[c].data();
+    for (int c = 0; c < dim; ++c) normalisation[c] = nodes.alpha[c].data();
+    for (int c = 0; c < shears; ++c) normalisation[first_shear + c] = nodes.alpha_shear[c].data();
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, source_.size(), 2048), [&](const tbb::blocked_range<std::size_t>& r) {
-        for (std::size_t k = r.begin(); k != r.end(); ++k) {
-            const std::size_t g = real_count + k, s = source_[k];
-            // Symmetric tensors in NodeStore order mirror across every plane of the ghost's mask.
-            const auto mirrored = [&](std::array<double, 6> t) {
-                for (std::size_t p = 0; p < planes_.size(); ++p) {
-                    if ((mask_[k] >> p) & 1u) planes_[p].reflect_tensor(dim, t);
-                }
-                return t;
-            };
-            std::array<double, 6> stress{};
-            for (int c = 0; c < comps; ++c) stress[c] = nodes.deviatoric_stress[c][s];
-            stress = mirrored(stress);
-            for (int c = 0; c < comps; ++c) nodes.deviatoric_stress[c][g] = stress[c];
-            // The normalisation is a symmetric tensor too. Across an aligned plane its diagonal
-            // (alpha) is unchanged and its off-diagonal entries (alpha_shear) flip like the shear
-            // stresses. Across an oblique one it is H A H; the per-direction normalisation, which
-            // keeps the diagonal only (its alpha_shear is zero), takes the diagonal of H A H: the
-            // frame-dependence of that normalisation (docs/orientation.md, "Oblique planes in the step").
-            const int first_shear = dim == 2 ? 2 : 3, shears = dim == 2 ? 1 : 3;
-            std::array<double, 6> normalisation{};
-            for (int c = 0; c < dim; ++c) normalisation[c] = nodes.alpha[c][s];
-            for (int c = 0; c < shears; ++c) normalisation[first_shear + c] = nodes.alpha_shear[c][s];
-            normalisation = mirrored(normalisation);
-            for (int c = 0; c < dim; ++c) nodes.alpha[c][g] = normalisation[c];
-            for (int c = 0; c < shears; ++c) nodes.alpha_shear[c][g] = normalisation[first_shear + c];
-            nodes.pressure[g] = nodes.pressure[s];
-            nodes.viscous_pressure[g] = nodes.viscous_pressure[s];
-            nodes.sound_speed[g] = nodes.sound_speed[s];
-            nodes.volume[g] = nodes.volume[s];
-            nodes.damage[g] = nodes.damage[s];
-            nodes.failed[g] = nodes.failed[s];
-            nodes.smallest_h[g] = nodes.smallest_h[s];
-        }
+        // Field by field, as in update().
+        mirror_tensors_to_ghosts(stress, comps, dim, real_count, r.begin(), r.end());
+        mirror_tensors_to_ghosts(normalisation, first_shear + shears, dim, real_count, r.begin(), r.end());
+        const NodeIndex* source = source_.data();
+        copy_to_ghosts(nodes.pressure.data(), source, real_count, r.begin(), r.end());
+        copy_to_ghosts(nodes.viscous_pressure.data(), source, real_count, r.begin(), r.end());
+        copy_to_ghosts(nodes.sound_speed.data(), source, real_count, r.begin(), r.end());
+        copy_to_ghosts(nodes.volume.data(), source, real_count, r.begin(), r.end());
+        copy_to_ghosts(nodes.damage.data(), source, real_count, r.begin(), r.end());
+        copy_to_ghosts(nodes.failed.data(), source, real_count, r.begin(), r.end());
+        copy_to_ghosts(nodes.smallest_h.data(), source, real_count, r.begin(), r.end());
     });
+}
+
+void GhostSet::mirror_tensors_to_ghosts(const std::array<double*, 6>& field, int components, int dim, std::size_t real_count,
+                                        std::size_t first, std::size_t last) const {
+    // A symmetric tensor in NodeStore order, its entries beyond `components` zero (and not stored),
+    // mirrored across every plane of the ghost's mask.
+    const std::array<double*, 6> f = field;
+    const NodeIndex* source = source_.data();
+    const std::uint8_t* mask = mask_.data();
+    for (std::size_t k = first; k != last; ++k) {
+        const std::size_t s = source[k];
+        std::array<double, 6> t{};
+        for (int c = 0; c < components; ++c) t[c] = f[c][s];
+        for (std::size_t p = 0; p < planes_.size(); ++p) {
+            if ((mask[k] >> p) & 1u) planes_[p].reflect_tensor(dim, t);
+        }
+        for (int c = 0; c < components; ++c) f[c][real_count + k] = t[c];
+    }
 }
 
 const CompressedRows& GhostSet::resolved_fixed_mirrors(const NodeStore& nodes, std::size_t real_count) {
@@ -421,26 +440,42 @@ void GhostSet::append_ghost_rows(CompressedRows& lists, std::size_t real_count) 
     // only those rows are read. A ghost row takes entries from its own source's row only, so both
     // passes below run over the sources in parallel without two writing one place, and a row's
     // entries keep the order of its source's row whatever the threads.
-    const auto target = [&](std::size_t s, NodeIndex entry) -> std::int64_t {
-        return index_[slot_[entry - real_count]][s];
+    // The ghost rows an entry goes to: s's own ghost across the planes of the ghost it lists, looked
+    // up once per source for each combination of planes (ghosts_of), then by the entry's slot.
+    const std::size_t slots = masks_.size();
+    const auto ghosts_of = [&](NodeIndex s, std::int32_t* out) {
+        for (std::size_t slot = 0; slot < slots; ++slot) out[slot] = index_[slot][s];
     };
     constexpr std::size_t grain = 256;  // sources per task
     const tbb::blocked_range<std::size_t> all_sources(0, sources_sorted_.size(), grain);
     std::vector<std::size_t> count(ghosts + 1, 0);
     std::atomic<std::size_t> first_missing{std::numeric_limits<std::size_t>::max()};  // the smallest source at fault
     tbb::parallel_for(all_sources, [&](const tbb::blocked_range<std::size_t>& r) {
+        // The arrays' addresses and each row's end as locals: a store to count[] or next[] may
+        // alias the offsets, so the loop would load them again after every entry.
+        std::vector<std::int32_t> ghost_of(slots);
+        const NodeIndex* const indices = lists.indices.data();
+        const std::uint8_t* const slot_of = slot_.data();
+        std::size_t* const counts = count.data();
         for (std::size_t q = r.begin(); q != r.end(); ++q) {
             const NodeIndex s = sources_sorted_[q];
-            for (NodeIndex j : lists.row(s)) {
-                if (j < real_count) continue;
-                const std::int64_t t = target(s, j);
-                if (t < 0) {
-                    std::size_t seen = first_missing.load();
-                    while (s < seen && !first_missing.compare_exchange_weak(seen, s)) {
-                    }
-                    break;
+            ghosts_of(s, ghost_of.data());
+            const std::size_t last = lists.offsets[s + 1];
+            bool missing = false;
+            // Without a branch on whether an entry is a ghost, which no predictor guesses (about a
+            // quarter of a source's entries are): a real entry adds 0 to count[0].
+            for (std::size_t e = lists.offsets[s]; e < last; ++e) {
+                const NodeIndex j = indices[e];
+                const bool ghost = j >= real_count;
+                const std::int32_t t = ghost_of[slot_of[ghost ? j - real_count : 0]];
+                const bool counted = ghost && t >= 0;
+                missing |= ghost && t < 0;
+                counts[counted ? static_cast<std::size_t>(t) - real_count + 1 : 0] += counted;
+            }
+            if (missing) {
+                std::size_t seen = first_missing.load();
+                while (s < seen && !first_missing.compare_exchange_weak(seen, s)) {
                 }
-                ++count[static_cast<std::size_t>(t) - real_count + 1];
             }
         }
     });
@@ -457,13 +492,22 @@ void GhostSet::append_ghost_rows(CompressedRows& lists, std::size_t real_count) 
     std::vector<std::size_t> next(ghosts);
     for (std::size_t k = 0; k < ghosts; ++k) next[k] = base + count[k];
     tbb::parallel_for(all_sources, [&](const tbb::blocked_range<std::size_t>& r) {
+        std::vector<std::int32_t> ghost_of(slots);
+        NodeIndex* const indices = lists.indices.data();
+        const std::uint8_t* const slot_of = slot_.data();
+        const NodeIndex* const sources = source_.data();
+        std::size_t* const place = next.data();
         for (std::size_t q = r.begin(); q != r.end(); ++q) {
             const NodeIndex s = sources_sorted_[q];
-            for (std::size_t e = lists.offsets[s]; e < lists.offsets[s + 1]; ++e) {
-                const NodeIndex j = lists.indices[e];
+            ghosts_of(s, ghost_of.data());
+            const std::size_t last = lists.offsets[s + 1];
+            // (Here the branch stays: without it, every real entry would add 0 to one place, a chain
+            // of loads and stores through memory that costs more than the guesses it misses.)
+            for (std::size_t e = lists.offsets[s]; e < last; ++e) {
+                const NodeIndex j = indices[e];
                 if (j < real_count) continue;
-                const std::size_t t = static_cast<std::size_t>(target(s, j)) - real_count;
-                lists.indices[next[t]++] = source_[j - real_count];
+                const auto t = static_cast<std::size_t>(ghost_of[slot_of[j - real_count]]) - real_count;
+                indices[place[t]++] = sources[j - real_count];
             }
         }
     });

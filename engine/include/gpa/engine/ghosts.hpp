@@ -216,6 +216,13 @@ private:
     bool keep_between_searches_ = false;
     CompressedRows resolved_;
     std::size_t mask_slot(std::uint8_t mask) const;
+    // Ghosts [first, last) take their sources' point or vector (mirrored across their planes), or
+    // symmetric tensor in NodeStore order (its first `components` entries).
+    enum class Mirrored { Point, Vector };
+    void mirror_to_ghosts(const std::array<double*, 3>& field, int dim, std::size_t real_count, std::size_t first,
+                          std::size_t last, Mirrored kind) const;
+    void mirror_tensors_to_ghosts(const std::array<double*, 6>& field, int components, int dim, std::size_t real_count,
+                                  std::size_t first, std::size_t last) const;
     // True when real node i may have (or be paired with) ghosts across the planes of `mask`.
     bool allowed(const NodeStore& nodes, std::size_t i, std::uint8_t mask) const {
         return (mask & lift_off_mask_ & ~nodes.plane_contact[i]) == 0;
