@@ -29,7 +29,7 @@ std::string totals_bytes(const Totals& t) {
         add(v);
     }
     for (const std::size_t v : {t.step, t.real_nodes, t.ghost_nodes, t.variable_nodes, t.failed_nodes, t.pairs,
-                                t.neighbour_searches}) {
+                                t.neighbour_searches, t.row_searches, t.rows_searched}) {
         add(v);
     }
     for (const auto& p : t.planes) {
@@ -112,6 +112,12 @@ std::vector<Case> cases() {
         scene.planes[0].friction_dynamic = 0.3;
         scene.planes[0].friction_static = 0.5;
         out.push_back({"elastic bar on a plane with friction", scene, 151, 260});
+    }
+    {
+        // A fast shot into a resting bar: rows searched alone before and after the checkpoint,
+        // each row from its own reference (NeighbourLists::search_rows).
+        auto scene = testing::struck_by_a_fast_body(testing::armco_cylinder(12, 40e-6), ConnectivityMode::Automatic);
+        out.push_back({"a bar struck by a fast shot, rows searched alone", scene, 61, 110});
     }
     {
         auto scene = three_d_quarter_bar(4);

@@ -668,6 +668,8 @@ void write_summary(const fs::path& file, const Simulation& sim, const RunSummary
     field("node_steps_per_second", json_number(stepping > 0.0 ? sim.node_steps() / stepping : 0.0));
     field("element_steps_per_second", json_number(stepping > 0.0 ? sim.element_steps() / stepping : 0.0));
     field("neighbour_searches", std::to_string(sim.totals().neighbour_searches));
+    field("row_searches", std::to_string(sim.totals().row_searches));
+    field("rows_searched", std::to_string(sim.totals().rows_searched));
     field("snapshots", std::to_string(run.snapshots), true);
     j += "}\n";
     // In plane strain the bodies are slices of unit thickness: the extensive quantities (masses,

@@ -147,6 +147,8 @@ TEST(Summary, PlaneStrainKeysOfExtensiveQuantitiesArePerMetre) {
         EXPECT_NE(text.find("\"length_m\":"), std::string::npos);
         // The searches the run made (the set-up's and any since), beside its timings.
         EXPECT_NE(text.find(fmt::format("\"neighbour_searches\": {}", sim.totals().neighbour_searches)), std::string::npos) << text;
+        EXPECT_NE(text.find(fmt::format("\"row_searches\": {}", sim.totals().row_searches)), std::string::npos) << text;
+        EXPECT_NE(text.find(fmt::format("\"rows_searched\": {}", sim.totals().rows_searched)), std::string::npos) << text;
         EXPECT_GE(sim.totals().neighbour_searches, 1u);
     }
     fs::remove_all(dir);

@@ -150,6 +150,28 @@ Scene armco_cylinder(int radial_cells, double end_time) {
     return s;
 }
 
+Scene struck_by_a_fast_body(Scene scene, ConnectivityMode target) {
+    BodySpec& bar = scene.bodies[0];
+    bar.velocity = {0.0, 0.0, 0.0};
+    bar.connectivity = target;
+    BodySpec shot = bar;
+    shot.name = "shot";
+    shot.connectivity = ConnectivityMode::Variable;
+    const int up = scene.geometry == GeometryKind::ThreeD ? 2 : 1;
+    shot.length = 2.0 * bar.spacing;
+    if (shot.shape == ShapeKind::Box) {
+        shot.size = {2.0 * bar.spacing, 2.0 * bar.spacing, shot.length};
+    } else {
+        shot.radius = 2.0 * bar.spacing;
+    }
+    shot.origin[static_cast<std::size_t>(up)] = bar.origin[static_cast<std::size_t>(up)] + bar.length + 0.75 * bar.spacing;
+    shot.velocity = {0.0, 0.0, 0.0};
+    shot.velocity[static_cast<std::size_t>(up)] = -3000.0;
+    scene.bodies.push_back(shot);
+    scene.solver.switch_plastic_strain = 0.05;
+    return scene;
+}
+
 std::string scene_file_refusal(const std::string& text, const std::filesystem::path& file) {
     std::ofstream(file) << text;
     try {

@@ -40,4 +40,8 @@ Scene short_copper_bar(GeometryKind geometry, int radial_cells);
 // the radius, nodal viscosity, no lift-off, with the given end time.
 Scene armco_cylinder(int radial_cells, double end_time);
 
+// `scene`'s first body at rest (with connectivity `target`), struck on its top end at 3000 m/s by
+// a variable "shot" of its own shape and material, 2 spacings long and 2 in radius (or across).
+Scene struck_by_a_fast_body(Scene scene, ConnectivityMode target);
+
 }  // namespace gpa::testing

@@ -196,11 +196,20 @@ void find_neighbours(const NodeStore& nodes, double a, std::size_t centres, Comp
 }
 
 void find_neighbours(const NodeStore& nodes, InfluenceDistance influence, std::size_t centres, CompressedRows& out,
-                     NeighbourScratch& scratch, const CompressedRows* extra_fixed, double skin, bool fixed_may_switch) {
+                     NeighbourScratch& scratch, const CompressedRows* extra_fixed, double skin, bool fixed_may_switch,
+                     std::span<const NodeIndex> only) {
     const double a = influence.value();
     if (!(skin >= 0.0) || !std::isfinite(skin)) throw InputError(fmt::format("find_neighbours: skin {} must be a finite length >= 0", skin));
     const std::size_t n = nodes.size();
     if (centres > n) throw InputError(fmt::format("find_neighbours: {} centres of {} nodes", centres, n));
+    for (std::size_t k = 0; k < only.size(); ++k) {
+        if (only[k] >= centres || (k > 0 && only[k] <= only[k - 1])) {
+            throw InputError(fmt::format("find_neighbours: the centres to search must ascend below {} (entry {} is {})", centres, k, only[k]));
+        }
+    }
+    // The rows to make: every centre's, or those of `only`.
+    const std::size_t rows = only.empty() ? centres : only.size();
+    const auto centre_of = [&](std::size_t k) -> std::size_t { return only.empty() ? k : only[k]; };
     if (nodes.fixed_neighbours.rows() < centres) {
         throw InputError(fmt::format("find_neighbours: fixed lists cover {} of {} centres",
                                      nodes.fixed_neighbours.rows(), centres));
@@ -397,22 +406,22 @@ void find_neighbours(const NodeStore& nodes, InfluenceDistance influence, std::s
 
     // Two passes, count and fill, straight into the output: no per-block buffers, so the peak
     // memory of a search is the lists themselves (the search runs once in many steps with a skin).
-    resize_with_slack(out.offsets, centres + 1);
+    resize_with_slack(out.offsets, rows + 1);
     out.offsets[0] = 0;
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, centres, search_block), [&](const tbb::blocked_range<std::size_t>& r) {
-        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rows, search_block), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t k = r.begin(); k != r.end(); ++k) {
             std::size_t count = 0;
-            visit(i, [&](NodeIndex) { ++count; });
-            out.offsets[i + 1] = count;
+            visit(centre_of(k), [&](NodeIndex) { ++count; });
+            out.offsets[k + 1] = count;
         }
     });
-    for (std::size_t i = 0; i < centres; ++i) out.offsets[i + 1] += out.offsets[i];
-    if (scratch.check_entries) scratch.check_entries(out.offsets[centres]);
-    resize_with_slack(out.indices, out.offsets[centres]);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, centres, search_block), [&](const tbb::blocked_range<std::size_t>& r) {
-        for (std::size_t i = r.begin(); i != r.end(); ++i) {
-            std::size_t next = out.offsets[i];
-            visit(i, [&](NodeIndex j) { out.indices[next++] = j; });
+    for (std::size_t k = 0; k < rows; ++k) out.offsets[k + 1] += out.offsets[k];
+    if (scratch.check_entries && only.empty()) scratch.check_entries(out.offsets[rows]);
+    resize_with_slack(out.indices, out.offsets[rows]);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rows, search_block), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t k = r.begin(); k != r.end(); ++k) {
+            std::size_t next = out.offsets[k];
+            visit(centre_of(k), [&](NodeIndex j) { out.indices[next++] = j; });
         }
     });
 }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 
 #include <fmt/format.h>
@@ -80,9 +81,19 @@ void NeighbourLists::place_ghosts(NodeStore& nodes, std::size_t real, GhostSet& 
     // Rounding of a ghost's mirrored coordinates against the search's r < 2 h_ij: a margin far
     // below any spacing (a billionth of the bulk's interaction radius at the last search), so
     // that a pair at the edge of its reach never misses its ghost.
+    rows_due_.clear();
     if (with_skin_ && !search_due_) {
         const double rounding = 1e-9 * searched_range_;
-        search_due_ = candidates_stale(nodes, real, ghosts, influence_distance, rounding) || switched_near_quiet_rows(nodes, real, ghosts);
+        const Staleness s = staleness(nodes, real, ghosts, influence_distance, rounding);
+        // A full search when the ghosts no longer cover the planes' reach, when a node has
+        // switched next to a quiet centre, or when a position or diameter is not finite (the
+        // phases after the search report it).
+        if (s.ghosts_short || !std::isfinite(s.largest_budget) || switched_near_quiet_rows(nodes, real, ghosts)) {
+            search_due_ = true;
+        } else if (!s.common_bound_holds && !(3.0 * s.largest_budget + rounding < skin_)) {
+            // Neither bound holds (the header): search the rows that have moved, or all.
+            choose_rows(nodes, real, influence_distance);
+        }
     }
     if (ghosts.empty()) return;
     // The skin follows the bulk of the nodes (DiameterSpread): a fraction of their interaction
@@ -93,37 +104,51 @@ void NeighbourLists::place_ghosts(NodeStore& nodes, std::size_t real, GhostSet& 
     if (!with_skin_) {
         ghosts.build(nodes, real, ghosts.pair_reach(nodes, real, a, rounding));
     } else if (search_due_) {
-        // Ghosts for every node within the candidates' reach, kept until the next search.
-        skin_ = solver_->neighbour_skin * range;
-        searched_range_ = range;
-        ghosts.build(nodes, real, ghosts.pair_reach(nodes, real, a, skin_ + rounding), true);
+        place_ghosts_for_search(nodes, real, ghosts, a, range);
     } else {
         ghosts.update(nodes, real);
     }
 }
 
-bool NeighbourLists::candidates_stale(const NodeStore& nodes, std::size_t real, const GhostSet& ghosts,
-                                      InfluenceDistance influence_distance, double rounding) const {
-    // A pair (i, j) left out by the last search had r >= 2 h_ij + skin then. Now r has shrunk by
-    // at most |u_i - u_j| <= 2 max |u - U| (u the displacements since the search, U any common
+void NeighbourLists::place_ghosts_for_search(NodeStore& nodes, std::size_t real, GhostSet& ghosts, double a, double range) {
+    // Ghosts for every node within the candidates' reach, kept until the next search.
+    skin_ = solver_->neighbour_skin * range;
+    searched_range_ = range;
+    ghosts.build(nodes, real, ghosts.pair_reach(nodes, real, a, skin_ + 1e-9 * range), true);
+}
+
+NeighbourLists::Staleness NeighbourLists::staleness(const NodeStore& nodes, std::size_t real, const GhostSet& ghosts,
+                                                    InfluenceDistance influence_distance, double rounding) const {
+    // The common bound (after a full search, while no row has been searched alone): a pair (i, j)
+    // left out by the last search had r >= 2 h_ij + skin then. Now r has shrunk by at most
+    // |u_i - u_j| <= 2 max |u - U| (u the displacements since the search, U any common
     // translation: the middle of the u), and 2 h_ij has grown by at most 2 a max (d - d_then).
     // The candidates are stale once those two can add up to the skin. Pairs with ghosts get the
     // same bound from the ghost set, which must also still hold every node within reach of a plane.
+    // The per-row budget (the header): |u_i| + a |d_i - d_then,i|, each row from its own search.
     struct Extent {
         std::array<double, 3> lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
         double growth = 0.0;
+        double budget = 0.0;
     };
     const int d = nodes.dim();
+    const double a = influence_distance.value();
+    const bool common = !rows_searched_alone_;
     const Extent e = tbb::parallel_reduce(
         tbb::blocked_range<std::size_t>(0, real, reduce_grain), Extent{},
         [&](const tbb::blocked_range<std::size_t>& r, Extent acc) {
             for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                double u2 = 0.0;
                 for (int c = 0; c < d; ++c) {
                     const double u = nodes.position[c][i] - searched_position_[c][i];
                     acc.lo[c] = std::min(acc.lo[c], u);
                     acc.hi[c] = std::max(acc.hi[c], u);
+                    u2 += u * u;
                 }
-                acc.growth = std::max(acc.growth, nodes.diameter[i] - searched_diameter_[i]);
+                const double change = nodes.diameter[i] - searched_diameter_[i];
+                acc.growth = std::max(acc.growth, change);
+                const double budget = std::sqrt(u2) + a * std::abs(change);
+                if (!(budget <= acc.budget)) acc.budget = budget;  // a NaN stays (std::max would drop it)
             }
             return acc;
         },
@@ -133,8 +158,16 @@ bool NeighbourLists::candidates_stale(const NodeStore& nodes, std::size_t real, 
                 x.hi[c] = std::max(x.hi[c], y.hi[c]);
             }
             x.growth = std::max(x.growth, y.growth);
+            if (!(y.budget <= x.budget) && !std::isnan(x.budget)) x.budget = y.budget;
             return x;
         });
+    Staleness out;
+    out.largest_budget = e.budget;  // NaN with a NaN position or diameter: place_ghosts searches in full
+    if (!ghosts.empty() && !ghosts.covers(nodes, real, ghosts.pair_reach(nodes, real, a, rounding))) {
+        out.ghosts_short = true;
+        return out;
+    }
+    if (!common) return out;
     std::array<double, 3> middle{0, 0, 0};
     for (int c = 0; c < d; ++c) middle[c] = 0.5 * (e.lo[c] + e.hi[c]);
     const double largest = tbb::parallel_reduce(
@@ -152,12 +185,34 @@ bool NeighbourLists::candidates_stale(const NodeStore& nodes, std::size_t real, 
         },
         [](double x, double y) { return std::max(x, y); });
     double closing = 2.0 * std::sqrt(largest);
-    if (!ghosts.empty()) {
-        if (!ghosts.covers(nodes, real, ghosts.pair_reach(nodes, real, influence_distance.value(), rounding))) return true;
-        closing = std::max(closing, ghosts.mirrored_displacement_bound(nodes, real, searched_position_));
+    if (!ghosts.empty()) closing = std::max(closing, ghosts.mirrored_displacement_bound(nodes, real, searched_position_));
+    // NaN positions make the bound NaN: it fails.
+    out.common_bound_holds = closing + 2.0 * a * e.growth < skin_;
+    return out;
+}
+
+void NeighbourLists::choose_rows(const NodeStore& nodes, std::size_t real, InfluenceDistance influence_distance) {
+    // A row is searched again when its budget is above a sixth of the skin: the rest keep at
+    // most that, so the next search of rows is due only when one of them has used up twice as
+    // much again. When they are many (a body in flight, say) or the candidates have grown by a
+    // quarter since the last full search (rows searched alone keep their old entries), a full
+    // search costs less and starts every row afresh.
+    const int d = nodes.dim();
+    const double a = influence_distance.value();
+    const double limit = skin_ / 6.0;
+    for (std::size_t i = 0; i < real; ++i) {
+        double u2 = 0.0;
+        for (int c = 0; c < d; ++c) {
+            const double u = nodes.position[c][i] - searched_position_[c][i];
+            u2 += u * u;
+        }
+        const double budget = std::sqrt(u2) + a * std::abs(nodes.diameter[i] - searched_diameter_[i]);
+        if (!(budget <= limit)) rows_due_.push_back(static_cast<NodeIndex>(i));
     }
-    // NaN positions make the bound NaN: search, and let the phases report them.
-    return !(closing + 2.0 * influence_distance.value() * e.growth < skin_);
+    if (rows_due_.size() > real / 8 || candidates_.entries() > full_search_entries_ + full_search_entries_ / 4) {
+        rows_due_.clear();
+        search_due_ = true;
+    }
 }
 
 bool NeighbourLists::switched_near_quiet_rows(const NodeStore& nodes, std::size_t real, const GhostSet& ghosts) const {
@@ -241,6 +296,14 @@ void NeighbourLists::search_candidates(NodeStore& nodes, std::size_t real, Ghost
     }
     for (int c = 0; c < nodes.dim(); ++c) searched_position_[c].assign(nodes.position[c].begin(), nodes.position[c].begin() + real);
     searched_diameter_.assign(nodes.diameter.begin(), nodes.diameter.begin() + real);
+    plan_with_ghost_rows(nodes, ghosts, real);
+    search_due_ = false;
+    rows_searched_alone_ = false;
+    full_search_entries_ = candidates_.entries();
+    ++searches_;
+}
+
+void NeighbourLists::plan_with_ghost_rows(const NodeStore& nodes, GhostSet& ghosts, std::size_t real) {
     // The scatter plan of the candidates (with their ghost rows) serves every step until the
     // next search: a plan without conflicts for some lists has none for any subset of them.
     if (ghosts.empty()) {
@@ -253,8 +316,113 @@ void NeighbourLists::search_candidates(NodeStore& nodes, std::size_t real, Ghost
         candidates_.offsets.resize(real + 1);
         candidates_.indices.resize(entries);
     }
-    search_due_ = false;
-    ++searches_;
+}
+
+void NeighbourLists::search_rows(NodeStore& nodes, std::size_t real, GhostSet& ghosts, InfluenceDistance influence_distance,
+                                 bool any_automatic) {
+    // The rows of rows_due_ searched as a full search would (find_neighbours with `only`), then
+    // every pair found put into both rows: (i, j) into row j for a real j, and for a ghost of
+    // source s across planes P, the ghost of i across P into row s (the same pair seen from the
+    // other side of the planes). A row keeps its old entries (the candidates only grow until the
+    // next full search, which choose_rows calls when they have grown by a quarter) and gains those
+    // it lacks at its end, in the order found: rows due first, in their own order, then the
+    // other side of each pair in the order of the rows due.
+    const CompressedRows* mirrored = ghosts.empty() ? nullptr : &ghosts.resolved_fixed_mirrors(nodes, real);
+    find_neighbours(nodes, influence_distance, real, found_, scratch_, mirrored, skin_, any_automatic, rows_due_);
+    std::vector<std::pair<NodeIndex, NodeIndex>> pairs;  // (row, entry), the order above
+    pairs.reserve(2 * found_.entries());
+    for (std::size_t k = 0; k < rows_due_.size(); ++k) {
+        for (NodeIndex j : found_.row(k)) pairs.emplace_back(rows_due_[k], j);
+    }
+    for (std::size_t k = 0; k < rows_due_.size(); ++k) {
+        const NodeIndex i = rows_due_[k];
+        for (NodeIndex j : found_.row(k)) {
+            if (j < real) {
+                pairs.emplace_back(j, i);
+                continue;
+            }
+            const std::int64_t image = ghosts.image_like(real, j, i);
+            if (image < 0) {
+                // i has no ghost across those planes (it has come within their reach since the
+                // ghosts were placed): the ghosts placed again, and a full search.
+                const double a = influence_distance.value();
+                place_ghosts_for_search(nodes, real, ghosts, a, bulk_interaction_radius(nodes, a, real));
+                search_candidates(nodes, real, ghosts, influence_distance, any_automatic);
+                return;
+            }
+            pairs.emplace_back(ghosts.source(j - real), static_cast<NodeIndex>(image));
+        }
+    }
+    // The pairs by row, in the order above (a stable counting sort), then those a row lacks.
+    std::vector<std::size_t> add_offsets(real + 1, 0);
+    for (const auto& p : pairs) ++add_offsets[p.first + 1];
+    for (std::size_t i = 0; i < real; ++i) add_offsets[i + 1] += add_offsets[i];
+    std::vector<NodeIndex> additions(pairs.size());
+    {
+        std::vector<std::size_t> next(add_offsets.begin(), add_offsets.end() - 1);
+        for (const auto& p : pairs) additions[next[p.first]++] = p.second;
+    }
+    std::vector<std::uint8_t> listed(nodes.size(), 0);
+    std::vector<NodeIndex> changed;  // ascending
+    std::vector<std::size_t> added_count;
+    std::size_t total_added = 0;
+    for (std::size_t i = 0; i < real; ++i) {
+        const std::size_t first = add_offsets[i], last = add_offsets[i + 1];
+        if (first == last) continue;
+        for (NodeIndex j : candidates_.row(i)) listed[j] = 1;
+        std::size_t kept = first;
+        for (std::size_t e = first; e < last; ++e) {
+            const NodeIndex j = additions[e];
+            if (listed[j] || j == i) continue;
+            listed[j] = 1;
+            additions[kept++] = j;
+        }
+        for (NodeIndex j : candidates_.row(i)) listed[j] = 0;
+        for (std::size_t e = first; e < kept; ++e) listed[additions[e]] = 0;
+        if (kept == first) continue;
+        changed.push_back(static_cast<NodeIndex>(i));
+        added_count.push_back(kept - first);
+        total_added += kept - first;
+    }
+    const std::size_t old_entries = candidates_.entries();
+    const std::size_t new_entries = old_entries + total_added;
+    if (scratch_.check_entries) scratch_.check_entries(new_entries);
+    // In place, from the last row back: each stretch of rows between two that gain entries moves
+    // up by the entries gained before its end, then the row before it takes its additions.
+    resize_with_slack(candidates_.indices, new_entries);
+    NodeIndex* index = candidates_.indices.data();
+    std::size_t end_old = old_entries, shift = total_added;
+    for (std::size_t c = changed.size(); c-- > 0;) {
+        const NodeIndex i = changed[c];
+        const std::size_t start_old = candidates_.offsets[i + 1];
+        if (shift > 0 && end_old > start_old) std::memmove(index + start_old + shift, index + start_old, (end_old - start_old) * sizeof(NodeIndex));
+        shift -= added_count[c];
+        const std::size_t first = add_offsets[i];
+        std::copy(additions.begin() + static_cast<std::ptrdiff_t>(first),
+                  additions.begin() + static_cast<std::ptrdiff_t>(first + added_count[c]), index + start_old + shift);
+        end_old = start_old;
+    }
+    {
+        std::size_t gained = 0, c = 0;
+        for (std::size_t i = 0; i < real; ++i) {
+            candidates_.offsets[i] += gained;
+            if (c < changed.size() && changed[c] == i) gained += added_count[c++];
+        }
+        candidates_.offsets[real] += gained;
+    }
+    // The rows searched take this moment as their reference, and their node's mode and quietness.
+    for (NodeIndex i : rows_due_) {
+        for (int c = 0; c < nodes.dim(); ++c) searched_position_[c][i] = nodes.position[c][i];
+        searched_diameter_[i] = nodes.diameter[i];
+        searched_fixed_[i] = nodes.connectivity[i] == Connectivity::Fixed;
+        quiet_[i] = scratch_.quiet.empty() ? 0 : scratch_.quiet[i];
+    }
+    any_quiet_ = std::find(quiet_.begin(), quiet_.end(), std::uint8_t{1}) != quiet_.end();
+    plan_with_ghost_rows(nodes, ghosts, real);
+    rows_searched_alone_ = true;
+    ++row_searches_;
+    rows_searched_ += rows_due_.size();
+    rows_due_.clear();
 }
 
 void NeighbourLists::update(NodeStore& nodes, std::size_t real, GhostSet& ghosts, InfluenceDistance influence_distance, bool any_automatic,
@@ -263,7 +431,11 @@ void NeighbourLists::update(NodeStore& nodes, std::size_t real, GhostSet& ghosts
     if (constant_ && lists_.rows() == real) return;
     const int d = nodes.dim();
     if (with_skin_) {
-        if (search_due_) search_candidates(nodes, real, ghosts, influence_distance, any_automatic);
+        if (search_due_) {
+            search_candidates(nodes, real, ghosts, influence_distance, any_automatic);
+        } else if (!rows_due_.empty()) {
+            search_rows(nodes, real, ghosts, influence_distance, any_automatic);
+        }
         filter_candidates(nodes, influence_distance.value(), candidates_, lattice_entries_, lists_, keep_scratch_);
         if (!ghosts.empty()) ghosts.remove_pairs_without_contact(lists_, nodes, real);
         if (solver_->check_neighbour_lists) check_against_search(nodes, real, ghosts, influence_distance, step);
@@ -307,6 +479,10 @@ void NeighbourLists::write_state(StateWriter& out, int dim) const {
     out.array(searched_fixed_);
     for (int c = 0; c < dim; ++c) out.array(searched_position_[c]);
     out.array(searched_diameter_);
+    out.value<std::uint8_t>(rows_searched_alone_);
+    out.value<std::uint64_t>(row_searches_);
+    out.value<std::uint64_t>(rows_searched_);
+    out.value<std::uint64_t>(full_search_entries_);
     write_plan(out, plan_);
 }
 
@@ -327,6 +503,10 @@ void NeighbourLists::read_state(StateReader& in, int dim, std::size_t node_count
     if (quiet_.size() != searched_fixed_.size() || quiet_.size() != lattice_entries_.size()) in.fail("its neighbour lists are damaged");
     for (int c = 0; c < dim; ++c) in.array(searched_position_[c]);
     in.array(searched_diameter_);
+    rows_searched_alone_ = in.value<std::uint8_t>() != 0;
+    row_searches_ = static_cast<std::size_t>(in.value<std::uint64_t>());
+    rows_searched_ = static_cast<std::size_t>(in.value<std::uint64_t>());
+    full_search_entries_ = static_cast<std::size_t>(in.value<std::uint64_t>());
     read_plan(in, plan_, node_count);
 }
 

@@ -9,6 +9,15 @@
 //
 // The lists of a step are the same with or without a skin, as sets; only the order of a row's
 // entries may differ (check_neighbour_lists compares them with a full search every step).
+//
+// When the candidates go stale, a few rows may be searched again instead of all (search_rows):
+// those of the nodes that have moved (or grown) by more than a sixth of the skin since their row
+// was searched. Each pair that search finds goes into both rows, so a pair left out of both rows
+// was farther than 2 h_ij + skin when the later of its two rows was searched; from then on it has
+// closed by at most the displacement of each of its nodes since that search, one of them bounded
+// by its own row's reference and the other by twice its budget (its displacement then and now
+// from its own reference). The candidates hold every pair while three times the largest budget
+// stays below the skin (docs/engine.md, "The search": rows searched alone).
 
 #include <array>
 #include <cstddef>
@@ -68,6 +77,9 @@ public:
     }
     const ScatterPlan& plan() const { return plan_; }
     std::size_t searches() const { return searches_; }
+    // Searches of some rows alone (the candidates of the nodes that had moved), and the rows they searched.
+    std::size_t row_searches() const { return row_searches_; }
+    std::size_t rows_searched() const { return rows_searched_; }
 
     // The nodes were renumbered (NodeStore::permute): search again in the new numbering.
     void invalidate();
@@ -94,8 +106,22 @@ public:
     void read_state(StateReader& in, int dim, std::size_t node_count);
 
 private:
-    bool candidates_stale(const NodeStore& nodes, std::size_t real, const GhostSet& ghosts, InfluenceDistance influence_distance,
-                          double rounding) const;
+    // What the geometry phase learns of the candidates: whether the ghosts still cover every
+    // node within reach of a plane, whether the bound of the last full search still holds (every
+    // reference from one moment; the displacements measured from their middle), and the largest
+    // budget of a row (its node's displacement and diameter change since its row was searched).
+    struct Staleness {
+        bool ghosts_short = false;
+        bool common_bound_holds = false;
+        double largest_budget = 0.0;
+    };
+    Staleness staleness(const NodeStore& nodes, std::size_t real, const GhostSet& ghosts, InfluenceDistance influence_distance,
+                        double rounding) const;
+    // The rows whose budget is above a sixth of the skin; a full search instead when they are many.
+    void choose_rows(const NodeStore& nodes, std::size_t real, InfluenceDistance influence_distance);
+    void search_rows(NodeStore& nodes, std::size_t real, GhostSet& ghosts, InfluenceDistance influence_distance, bool any_automatic);
+    void plan_with_ghost_rows(const NodeStore& nodes, GhostSet& ghosts, std::size_t real);
+    void place_ghosts_for_search(NodeStore& nodes, std::size_t real, GhostSet& ghosts, double a, double range);
     bool switched_near_quiet_rows(const NodeStore& nodes, std::size_t real, const GhostSet& ghosts) const;
     void search_candidates(NodeStore& nodes, std::size_t real, GhostSet& ghosts, InfluenceDistance influence_distance,
                            bool any_automatic);
@@ -120,8 +146,15 @@ private:
     std::vector<std::uint8_t> quiet_, searched_fixed_;
     bool any_quiet_ = false;
     std::vector<std::uint8_t> keep_scratch_;
+    // Per row, the position and diameter of its node when the row was last searched (all from
+    // one moment after a full search; rows searched alone since take their own moment).
     std::array<std::vector<double>, 3> searched_position_;
     std::vector<double> searched_diameter_;
+    bool rows_searched_alone_ = false;  // since the last full search: only the per-row bound holds
+    std::size_t row_searches_ = 0, rows_searched_ = 0;
+    std::size_t full_search_entries_ = 0;  // the candidates' entries after the last full search
+    std::vector<NodeIndex> rows_due_;      // rows to search alone in this step's neighbours phase
+    CompressedRows found_;                 // their rows (search_rows)
     ScatterPlan plan_;
     std::vector<double> kept_weight_over_r2_;  // per list entry of the rows [0, kept_rows_)
     std::size_t kept_rows_ = 0;

@@ -533,6 +533,8 @@ void Simulation::Impl::sum_totals() {
     totals.failed_nodes = s.failed;
     totals.pairs = lists().entries();
     totals.neighbour_searches = neighbour_lists.searches();
+    totals.row_searches = neighbour_lists.row_searches();
+    totals.rows_searched = neighbour_lists.rows_searched();
     rigid_planes.report(ghosts, elements ? &elements->reactions() : nullptr, elements ? &elements->impulses() : nullptr,
                         totals.planes);
     measures.body_totals(scene, nodes, real, true, &s, totals.bodies);
@@ -835,7 +837,7 @@ void Simulation::Impl::write_state(StateWriter& out) const {
         out.value<double>(v);
     }
     for (const std::size_t v : {t.step, t.real_nodes, t.ghost_nodes, t.variable_nodes, t.failed_nodes, t.pairs,
-                                t.neighbour_searches}) {
+                                t.neighbour_searches, t.row_searches, t.rows_searched}) {
         out.value<std::uint64_t>(v);
     }
     out.value<std::uint64_t>(t.planes.size());
@@ -899,7 +901,7 @@ void Simulation::Impl::read_state(StateReader& in) {
         *v = in.value<double>();
     }
     for (std::size_t* v : {&t.step, &t.real_nodes, &t.ghost_nodes, &t.variable_nodes, &t.failed_nodes, &t.pairs,
-                           &t.neighbour_searches}) {
+                           &t.neighbour_searches, &t.row_searches, &t.rows_searched}) {
         *v = static_cast<std::size_t>(in.value<std::uint64_t>());
     }
     const auto planes = in.value<std::uint64_t>();

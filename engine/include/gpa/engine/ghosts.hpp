@@ -187,6 +187,11 @@ public:
 
     std::size_t count() const { return source_.size(); }
     NodeIndex source(std::size_t ghost) const { return source_[ghost]; }
+    // The ghost of real node `node` across the planes of ghost node `like` (both node indices,
+    // ghosts numbered from real_count), or -1 when the set holds none.
+    std::int64_t image_like(std::size_t real_count, NodeIndex like, NodeIndex node) const {
+        return index_[slot_[like - real_count]][node];
+    }
     std::uint8_t planes_of(std::size_t ghost) const { return mask_[ghost]; }
 
     // The force the planes exert on the real nodes along each plane's normal, from the forces

@@ -8,6 +8,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <span>
 #include <vector>
 
 #include "gpa/engine/compressed_rows.hpp"
@@ -79,10 +80,13 @@ struct NeighbourScratch {
 void find_neighbours(const NodeStore& nodes, double influence_distance, std::size_t centres,
                      CompressedRows& out, NeighbourScratch& scratch,
                      const CompressedRows* extra_fixed = nullptr, double skin = 0.0, bool fixed_may_switch = false);
-// The same with a checked once (weights.hpp, InfluenceDistance): what a run calls.
+// The same with a checked once (weights.hpp, InfluenceDistance): what a run calls. With `only`
+// (centres below `centres`, ascending) the rows of those centres alone: row k of `out` is the row
+// of centre only[k], entry for entry what a search of every centre gives it.
 void find_neighbours(const NodeStore& nodes, InfluenceDistance influence_distance, std::size_t centres,
                      CompressedRows& out, NeighbourScratch& scratch,
-                     const CompressedRows* extra_fixed = nullptr, double skin = 0.0, bool fixed_may_switch = false);
+                     const CompressedRows* extra_fixed = nullptr, double skin = 0.0, bool fixed_may_switch = false,
+                     std::span<const NodeIndex> only = {});
 CompressedRows find_neighbours(const NodeStore& nodes, double influence_distance, std::size_t centres);
 
 // The pairs of the moment from candidate lists, in the candidates' order: of row i, the first

@@ -135,6 +135,8 @@ struct Totals {
     std::size_t real_nodes = 0, ghost_nodes = 0, variable_nodes = 0, failed_nodes = 0, pairs = 0;
     std::size_t element_nodes = 0, elements = 0;  // nodes and quadrilaterals of element bodies
     std::size_t neighbour_searches = 0;  // full searches so far (the others steps reuse candidate lists)
+    // Searches of the rows of the nodes that had moved, alone, and the rows they searched.
+    std::size_t row_searches = 0, rows_searched = 0;
     // Fixed nodes of automatic bodies that the last step switched because a lattice cell had
     // collapsed or inverted (before their plastic strain reached the threshold), and the first of them.
     std::size_t collapse_switches = 0;
