@@ -91,6 +91,7 @@ struct Round {
     double step_seconds = 0.0;
     std::map<std::string, double> phases;
     std::size_t searches = 0;
+    std::size_t row_searches = 0;  // searches of some rows alone (NeighbourLists::search_rows)
 };
 
 struct Runner {
@@ -101,7 +102,7 @@ struct Runner {
     Round run(std::size_t steps) {
         Round r;
         const auto before = sim->phase_times();
-        const std::size_t searches = sim->totals().neighbour_searches;
+        const std::size_t searches = sim->totals().neighbour_searches, row_searches = sim->totals().row_searches;
         const auto t0 = Clock::now();
         for (std::size_t k = 0; k < steps; ++k) sim->step();
         r.step_seconds = std::chrono::duration<double>(Clock::now() - t0).count() / static_cast<double>(steps);
@@ -110,6 +111,7 @@ struct Runner {
             r.phases[after[p].name] = (after[p].seconds - before[p].seconds) / static_cast<double>(steps);
         }
         r.searches = sim->totals().neighbour_searches - searches;
+        r.row_searches = sim->totals().row_searches - row_searches;
         return r;
     }
 };
@@ -248,13 +250,14 @@ int main(int argc, char** argv) {
             }
             std::vector<double> base_times;
             std::string whole = "| whole step |", rate = "| node-steps/s |", pair_rate = "| pair-steps/s |", speedup = "| speed-up |",
-                        searched = "| searches/round |";
+                        searched = "| searches/round |", rows_searched = "| row searches/round |";
             for (const auto& r : runners) {
                 std::vector<double> v;
-                std::size_t searches = 0;
+                std::size_t searches = 0, row_searches = 0;
                 for (const auto& round : r.rounds) {
                     v.push_back(round.step_seconds);
                     searches += round.searches;
+                    row_searches += round.row_searches;
                 }
                 const double t = median(v);
                 if (base_times.empty()) base_times.push_back(t);
@@ -264,8 +267,9 @@ int main(int argc, char** argv) {
                 pair_rate += fmt::format(" {:.3g} M |", static_cast<double>(r.sim->totals().pairs) / t / 1e6);
                 speedup += fmt::format(" {:.2f}x |", base_times.front() / t);
                 searched += fmt::format(" {:.1f} of {} |", static_cast<double>(searches) / static_cast<double>(r.rounds.size()), steps);
+                rows_searched += fmt::format(" {:.1f} |", static_cast<double>(row_searches) / static_cast<double>(r.rounds.size()));
             }
-            fmt::print("{}\n{}\n{}\n{}\n{}\n\n", whole, rate, pair_rate, speedup, searched);
+            fmt::print("{}\n{}\n{}\n{}\n{}\n{}\n\n", whole, rate, pair_rate, speedup, searched, rows_searched);
             std::fflush(stdout);
         }
     }

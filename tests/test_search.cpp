@@ -211,6 +211,42 @@ TEST(Search, AFixedCentreFarFromOtherBodiesAndVariableNodesIsQuiet) {
     expect_same_sets(lists, find_neighbours_brute_force(n, 1.0, n.size()));
 }
 
+// The rows of some centres alone (find_neighbours with `only`, NeighbourLists::search_rows) are
+// entry for entry the rows a search of every centre gives them: lattice rows, quiet and not,
+// candidates with a skin, outsized nodes; centres that do not ascend are refused.
+TEST(Search, TheRowsOfSomeCentresAloneAreThoseOfAFullSearch) {
+    NodeStore blocks = two_fixed_blocks_and_a_variable_one();
+    NodeStore cloud = random_cloud(GeometryKind::PlaneStrain, 3000, 7);
+    make_outsized(cloud, 7);
+    for (NodeStore* n : {&blocks, &cloud}) {
+        for (double skin : {0.0, 0.05}) {
+            NeighbourScratch scratch;
+            CompressedRows all, some;
+            find_neighbours(*n, InfluenceDistance(1.2), n->size(), all, scratch, nullptr, skin, true);
+            const std::vector<std::uint8_t> quiet_all = scratch.quiet;
+            std::vector<NodeIndex> only;
+            for (std::size_t i = 1; i < n->size(); i += 7) only.push_back(static_cast<NodeIndex>(i));
+            find_neighbours(*n, InfluenceDistance(1.2), n->size(), some, scratch, nullptr, skin, true, only);
+            ASSERT_EQ(some.rows(), only.size());
+            for (std::size_t k = 0; k < only.size(); ++k) {
+                const auto a = all.row(only[k]), b = some.row(k);
+                ASSERT_TRUE(std::equal(a.begin(), a.end(), b.begin(), b.end())) << "centre " << only[k] << ", skin " << skin;
+                if (!quiet_all.empty()) {
+                    ASSERT_EQ(scratch.quiet[only[k]], quiet_all[only[k]]) << "centre " << only[k];
+                }
+            }
+        }
+    }
+    NeighbourScratch scratch;
+    CompressedRows out;
+    const std::vector<NodeIndex> descending{5, 3};
+    EXPECT_THROW(find_neighbours(blocks, InfluenceDistance(1.0), blocks.size(), out, scratch, nullptr, 0.0, false, descending),
+                 InputError);
+    const std::vector<NodeIndex> beyond{static_cast<NodeIndex>(blocks.size())};
+    EXPECT_THROW(find_neighbours(blocks, InfluenceDistance(1.0), blocks.size(), out, scratch, nullptr, 0.0, false, beyond),
+                 InputError);
+}
+
 TEST(Search, ResultDoesNotDependOnThreadCountOrScratchReuse) {
     auto n = random_cloud(GeometryKind::PlaneStrain, 5000, 3);
     const auto reference = find_neighbours(n, 1.0, n.size());
