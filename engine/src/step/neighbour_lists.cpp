@@ -119,75 +119,85 @@ void NeighbourLists::place_ghosts_for_search(NodeStore& nodes, std::size_t real,
 
 NeighbourLists::Staleness NeighbourLists::staleness(const NodeStore& nodes, std::size_t real, const GhostSet& ghosts,
                                                     InfluenceDistance influence_distance, double rounding) const {
-    // The common bound (after a full search, while no row has been searched alone): a pair (i, j)
-    // left out by the last search had r >= 2 h_ij + skin then. Now r has shrunk by at most
-    // |u_i - u_j| <= 2 max |u - U| (u the displacements since the search, U any common
-    // translation: the middle of the u), and 2 h_ij has grown by at most 2 a max (d - d_then).
-    // The candidates are stale once those two can add up to the skin. Pairs with ghosts get the
-    // same bound from the ghost set, which must also still hold every node within reach of a plane.
-    // The per-row budget (the header): |u_i| + a |d_i - d_then,i|, each row from its own search.
-    struct Extent {
-        std::array<double, 3> lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
-        double growth = 0.0;
-        double budget = 0.0;
-    };
     const int d = nodes.dim();
     const double a = influence_distance.value();
-    const bool common = !rows_searched_alone_;
-    const Extent e = tbb::parallel_reduce(
-        tbb::blocked_range<std::size_t>(0, real, reduce_grain), Extent{},
-        [&](const tbb::blocked_range<std::size_t>& r, Extent acc) {
-            for (std::size_t i = r.begin(); i != r.end(); ++i) {
-                double u2 = 0.0;
-                for (int c = 0; c < d; ++c) {
-                    const double u = nodes.position[c][i] - searched_position_[c][i];
-                    acc.lo[c] = std::min(acc.lo[c], u);
-                    acc.hi[c] = std::max(acc.hi[c], u);
-                    u2 += u * u;
-                }
-                const double change = nodes.diameter[i] - searched_diameter_[i];
-                acc.growth = std::max(acc.growth, change);
-                const double budget = std::sqrt(u2) + a * std::abs(change);
-                if (!(budget <= acc.budget)) acc.budget = budget;  // a NaN stays (std::max would drop it)
-            }
-            return acc;
-        },
-        [](Extent x, const Extent& y) {
-            for (int c = 0; c < 3; ++c) {
-                x.lo[c] = std::min(x.lo[c], y.lo[c]);
-                x.hi[c] = std::max(x.hi[c], y.hi[c]);
-            }
-            x.growth = std::max(x.growth, y.growth);
-            if (!(y.budget <= x.budget) && !std::isnan(x.budget)) x.budget = y.budget;
-            return x;
-        });
     Staleness out;
-    out.largest_budget = e.budget;  // NaN with a NaN position or diameter: place_ghosts searches in full
+    // The ghost set must still hold every node within reach of a plane.
     if (!ghosts.empty() && !ghosts.covers(nodes, real, ghosts.pair_reach(nodes, real, a, rounding))) {
         out.ghosts_short = true;
         return out;
     }
-    if (!common) return out;
-    std::array<double, 3> middle{0, 0, 0};
-    for (int c = 0; c < d; ++c) middle[c] = 0.5 * (e.lo[c] + e.hi[c]);
-    const double largest = tbb::parallel_reduce(
+    if (!rows_searched_alone_) {
+        // The common bound (after a full search, while no row has been searched alone): a pair
+        // (i, j) left out by the last search had r >= 2 h_ij + skin then. Now r has shrunk by at
+        // most |u_i - u_j| <= 2 max |u - U| (u the displacements since the search, U any common
+        // translation: the middle of the u), and 2 h_ij has grown by at most 2 a max (d - d_then).
+        // The candidates are stale once those two can add up to the skin. Pairs with ghosts get
+        // the same bound from the ghost set.
+        struct Extent {
+            std::array<double, 3> lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
+            double growth = 0.0;
+        };
+        const Extent e = tbb::parallel_reduce(
+            tbb::blocked_range<std::size_t>(0, real, reduce_grain), Extent{},
+            [&](const tbb::blocked_range<std::size_t>& r, Extent acc) {
+                for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                    for (int c = 0; c < d; ++c) {
+                        const double u = nodes.position[c][i] - searched_position_[c][i];
+                        acc.lo[c] = std::min(acc.lo[c], u);
+                        acc.hi[c] = std::max(acc.hi[c], u);
+                    }
+                    acc.growth = std::max(acc.growth, nodes.diameter[i] - searched_diameter_[i]);
+                }
+                return acc;
+            },
+            [](Extent x, const Extent& y) {
+                for (int c = 0; c < 3; ++c) {
+                    x.lo[c] = std::min(x.lo[c], y.lo[c]);
+                    x.hi[c] = std::max(x.hi[c], y.hi[c]);
+                }
+                x.growth = std::max(x.growth, y.growth);
+                return x;
+            });
+        std::array<double, 3> middle{0, 0, 0};
+        for (int c = 0; c < d; ++c) middle[c] = 0.5 * (e.lo[c] + e.hi[c]);
+        const double largest = tbb::parallel_reduce(
+            tbb::blocked_range<std::size_t>(0, real, reduce_grain), 0.0,
+            [&](const tbb::blocked_range<std::size_t>& r, double acc) {
+                for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                    double u2 = 0.0;
+                    for (int c = 0; c < d; ++c) {
+                        const double u = nodes.position[c][i] - searched_position_[c][i] - middle[c];
+                        u2 += u * u;
+                    }
+                    acc = std::max(acc, u2);
+                }
+                return acc;
+            },
+            [](double x, double y) { return std::max(x, y); });
+        double closing = 2.0 * std::sqrt(largest);
+        if (!ghosts.empty()) closing = std::max(closing, ghosts.mirrored_displacement_bound(nodes, real, searched_position_));
+        // NaN positions make the bound NaN: it fails.
+        out.common_bound_holds = closing + 2.0 * a * e.growth < skin_;
+        if (out.common_bound_holds) return out;
+    }
+    // The per-row budget (the header): |u_i| + a |d_i - d_then,i|, each row from its own search;
+    // NaN with a NaN position or diameter (place_ghosts then searches in full).
+    out.largest_budget = tbb::parallel_reduce(
         tbb::blocked_range<std::size_t>(0, real, reduce_grain), 0.0,
         [&](const tbb::blocked_range<std::size_t>& r, double acc) {
             for (std::size_t i = r.begin(); i != r.end(); ++i) {
                 double u2 = 0.0;
                 for (int c = 0; c < d; ++c) {
-                    const double u = nodes.position[c][i] - searched_position_[c][i] - middle[c];
+                    const double u = nodes.position[c][i] - searched_position_[c][i];
                     u2 += u * u;
                 }
-                acc = std::max(acc, u2);
+                const double budget = std::sqrt(u2) + a * std::abs(nodes.diameter[i] - searched_diameter_[i]);
+                if (!(budget <= acc)) acc = budget;  // a NaN stays (std::max would drop it)
             }
             return acc;
         },
-        [](double x, double y) { return std::max(x, y); });
-    double closing = 2.0 * std::sqrt(largest);
-    if (!ghosts.empty()) closing = std::max(closing, ghosts.mirrored_displacement_bound(nodes, real, searched_position_));
-    // NaN positions make the bound NaN: it fails.
-    out.common_bound_holds = closing + 2.0 * a * e.growth < skin_;
+        [](double x, double y) { return std::isnan(x) ? x : (std::isnan(y) || y > x ? y : x); });
     return out;
 }
 
@@ -515,7 +525,9 @@ void NeighbourLists::memory_use(MemoryUse& out) const {
     add_memory(out, "neighbour lists: kept pair terms", allocated_bytes(kept_weight_over_r2_));
     add_memory(out, "neighbour lists: skin candidates", allocated_bytes(candidates_.indices) + allocated_bytes(candidates_.offsets) +
                                                             allocated_bytes(lattice_entries_) + allocated_bytes(keep_scratch_) +
-                                                            allocated_bytes(quiet_) + allocated_bytes(searched_fixed_));
+                                                            allocated_bytes(quiet_) + allocated_bytes(searched_fixed_) +
+                                                            allocated_bytes(found_.indices) + allocated_bytes(found_.offsets) +
+                                                            allocated_bytes(rows_due_));
     std::size_t searched = allocated_bytes(searched_diameter_);
     for (const auto& p : searched_position_) searched += allocated_bytes(p);
     add_memory(out, "neighbour lists: positions at the last search", searched);
