@@ -128,13 +128,18 @@ TEST(MixedConnectivity, PairsAreSymmetricAndLatticePairsLinkFixedNodesOnly) {
 
 // The cell check: 1 on the undeformed lattice, det F under a uniform deformation (scaled by x/x0
 // in axisymmetric geometry), and <= 0 where a node has been pushed through its neighbour.
+testing::LatticeOptions fixed_cells(GeometryKind geometry) {
+    testing::LatticeOptions o;
+    o.geometry = geometry;
+    o.cells = 6;
+    o.spacing = lattice_spacing;
+    o.connectivity = Connectivity::Fixed;
+    return o;
+}
+
 TEST(LatticeCells, RatioIsOneUndeformedDetFUnderUniformDeformationAndNegativeWhenInverted) {
     for (auto geometry : {GeometryKind::PlaneStrain, GeometryKind::Axisymmetric, GeometryKind::ThreeD}) {
-        testing::LatticeOptions o;
-        o.geometry = geometry;
-        o.cells = 6;
-        o.spacing = lattice_spacing;
-        o.connectivity = Connectivity::Fixed;
+        const testing::LatticeOptions o = fixed_cells(geometry);
         NodeStore nodes = testing::make_lattice(o);
         std::vector<double> ratio;
         smallest_lattice_cell_ratios(nodes, nodes.size(), ratio);
@@ -164,6 +169,39 @@ TEST(LatticeCells, RatioIsOneUndeformedDetFUnderUniformDeformationAndNegativeWhe
         EXPECT_LE(std::count_if(ratio.begin(), ratio.end(), [](double r) { return r <= collapsed_cell_ratio; }),
                   static_cast<long>(dim == 3 ? 27 : 9))
             << "only the node and its lattice neighbours are affected";
+    }
+}
+
+// The axis neighbours kept between calls (LatticeAxes) give the ratios found afresh, bit for bit,
+// while nodes switch one batch after another (a kept neighbour that has switched is replaced by
+// the next fixed one along its axis, in a stencil that reaches beyond the box), and after forget().
+TEST(LatticeCells, KeptAxisNeighboursGiveTheRatiosFoundAfresh) {
+    for (auto geometry : {GeometryKind::PlaneStrain, GeometryKind::Axisymmetric, GeometryKind::ThreeD}) {
+        testing::LatticeOptions o = fixed_cells(geometry);
+        o.stencil_reach = 2.6;  // the stencil of a = 1.3: every lattice node within 2.6 spacings
+        NodeStore nodes = testing::make_lattice(o);
+        testing::jitter(nodes, 0.1, lattice_spacing, 3);
+        LatticeAxes axes;
+        std::vector<double> kept, fresh;
+        std::size_t replaced = 0;
+        for (std::size_t batch = 0; batch < 4; ++batch) {
+            smallest_lattice_cell_ratios(nodes, nodes.size(), kept, &axes);
+            smallest_lattice_cell_ratios(nodes, nodes.size(), fresh);
+            ASSERT_EQ(kept.size(), fresh.size());
+            for (std::size_t i = 0; i < kept.size(); ++i) {
+                ASSERT_EQ(std::memcmp(&kept[i], &fresh[i], sizeof(double)), 0) << name_of(geometry) << ", batch " << batch << ", node " << i;
+            }
+            // Every seventh fixed node from `batch` on switches.
+            for (std::size_t i = batch; i < nodes.size(); i += 7) {
+                if (nodes.connectivity[i] == Connectivity::Fixed) ++replaced;
+                nodes.connectivity[i] = Connectivity::Variable;
+            }
+        }
+        EXPECT_GT(replaced, nodes.size() / 2) << "the batches must switch many kept neighbours";
+        axes.forget();
+        smallest_lattice_cell_ratios(nodes, nodes.size(), kept, &axes);
+        smallest_lattice_cell_ratios(nodes, nodes.size(), fresh);
+        EXPECT_EQ(std::memcmp(kept.data(), fresh.data(), kept.size() * sizeof(double)), 0) << name_of(geometry);
     }
 }
 

@@ -218,6 +218,7 @@ void Simulation::Impl::reorder() {
     const double cell = bulk_interaction_radius(nodes, a().value(), real);
     nodes.permute(locality_order(nodes, cell, 0, real));
     neighbour_lists.invalidate();  // rebuilt in the new numbering by the neighbours phase
+    switching_part.forget_lattice_axes();
     external.map_ids(nodes, real);
     regroup_materials();
     regions.index(nodes, real);
@@ -875,6 +876,7 @@ void Simulation::Impl::read_state(StateReader& in) {
     if (n < real) in.fail("it holds fewer nodes than the scene's bodies (a damaged checkpoint)");
     ghosts.read_state(in, real, n);
     neighbour_lists.read_state(in, dim(), n);
+    switching_part.forget_lattice_axes();  // found again from the restored nodes
     in.tag("TIME");
     in.array(largest_bond_q);
     time = in.value<double>();

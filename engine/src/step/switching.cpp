@@ -63,7 +63,7 @@ Switching::Report Switching::switch_nodes(const Scene& scene, NodeStore& nodes, 
     // there; in an automatic body the node switches at once. Then paper section 6: a fixed node of
     // an automatic body switches to variable connectivity, for the rest of the run, once its
     // equivalent plastic strain exceeds the threshold.
-    smallest_lattice_cell_ratios(nodes, real, cell_ratio_);
+    smallest_lattice_cell_ratios(nodes, real, cell_ratio_, &axes_);
     const double threshold = scene.solver.switch_plastic_strain;
     Report report;
     const auto where = [&](std::size_t i) {

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "gpa/engine/lattice_check.hpp"
 #include "gpa/engine/node_store.hpp"
 #include "gpa/engine/scene.hpp"
 
@@ -41,13 +42,19 @@ public:
     };
     Report switch_nodes(const Scene& scene, NodeStore& nodes, std::size_t real);
 
-    void memory_use(MemoryUse& out) const { add_memory(out, "switching: lattice cell ratios", allocated_bytes(cell_ratio_)); }
+    // The nodes were renumbered or the state restored: the kept axis neighbours (lattice_check.hpp) are found again.
+    void forget_lattice_axes() { axes_.forget(); }
+    void memory_use(MemoryUse& out) const {
+        add_memory(out, "switching: lattice cell ratios", allocated_bytes(cell_ratio_));
+        add_memory(out, "switching: lattice axis neighbours", allocated_bytes(axes_.neighbour) + allocated_bytes(axes_.known));
+    }
 
 private:
     std::vector<ConnectivityMode> body_mode_;
     bool any_automatic_ = false;
     bool any_lattice_ = false;
     std::vector<double> cell_ratio_;  // per node, its smallest lattice-cell volume ratio (lattice_check.hpp)
+    LatticeAxes axes_;                // each fixed node's axis neighbours, kept between steps
 };
 
 }  // namespace gpa

@@ -5,6 +5,7 @@
 // has inverted or collapsed, and the node's lattice stencil no longer describes the material.
 
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #include "gpa/engine/geometry.hpp"
@@ -16,9 +17,21 @@ namespace gpa {
 // 0.6 at 100 GPa), so the stencil has tangled or inverted.
 inline constexpr double collapsed_cell_ratio = 0.2;
 
+// Each fixed node's axis neighbours (the nearest fixed lattice neighbour on each side of each
+// axis), kept from one call to the next. Nodes only ever switch from fixed to variable, so a kept
+// set stays right while its own nodes are still fixed, and is found again when one has switched.
+// forget() after the nodes are renumbered or restored.
+struct LatticeAxes {
+    std::vector<std::int32_t> neighbour;  // 2 D per node: [axis][side], -1 for none
+    std::vector<std::uint8_t> known;      // per node
+    void forget() { known.clear(); }
+};
+
 // For every fixed-connectivity node in [0, real_count): the smallest volume ratio of its lattice
 // cells whose edge nodes are all still fixed, or +infinity where it has none. Variable nodes get
-// +infinity. Parallel; each node's value depends only on the state, not on the thread count.
-void smallest_lattice_cell_ratios(const NodeStore& nodes, std::size_t real_count, std::vector<double>& out);
+// +infinity. Parallel; each node's value depends only on the state, not on the thread count, nor
+// on whether `axes` kept its axis neighbours from an earlier call.
+void smallest_lattice_cell_ratios(const NodeStore& nodes, std::size_t real_count, std::vector<double>& out,
+                                  LatticeAxes* axes = nullptr);
 
 }  // namespace gpa
