@@ -117,6 +117,17 @@ void NeighbourLists::place_ghosts_for_search(NodeStore& nodes, std::size_t real,
     ghosts.build(nodes, real, ghosts.pair_reach(nodes, real, a, skin_ + 1e-9 * range), true);
 }
 
+double NeighbourLists::row_budget(const NodeStore& nodes, std::size_t i, double a) const {
+    // Row i's budget (the header): its node's displacement since the row was searched, plus a
+    // times the change of its diameter since then.
+    double u2 = 0.0;
+    for (int c = 0; c < nodes.dim(); ++c) {
+        const double u = nodes.position[c][i] - searched_position_[c][i];
+        u2 += u * u;
+    }
+    return std::sqrt(u2) + a * std::abs(nodes.diameter[i] - searched_diameter_[i]);
+}
+
 NeighbourLists::Staleness NeighbourLists::staleness(const NodeStore& nodes, std::size_t real, const GhostSet& ghosts,
                                                     InfluenceDistance influence_distance, double rounding) const {
     const int d = nodes.dim();
@@ -187,12 +198,7 @@ NeighbourLists::Staleness NeighbourLists::staleness(const NodeStore& nodes, std:
         tbb::blocked_range<std::size_t>(0, real, reduce_grain), 0.0,
         [&](const tbb::blocked_range<std::size_t>& r, double acc) {
             for (std::size_t i = r.begin(); i != r.end(); ++i) {
-                double u2 = 0.0;
-                for (int c = 0; c < d; ++c) {
-                    const double u = nodes.position[c][i] - searched_position_[c][i];
-                    u2 += u * u;
-                }
-                const double budget = std::sqrt(u2) + a * std::abs(nodes.diameter[i] - searched_diameter_[i]);
+                const double budget = row_budget(nodes, i, a);
                 if (!(budget <= acc)) acc = budget;  // a NaN stays (std::max would drop it)
             }
             return acc;
@@ -207,17 +213,10 @@ void NeighbourLists::choose_rows(const NodeStore& nodes, std::size_t real, Influ
     // much again. When they are many (a body in flight, say) or the candidates have grown by a
     // quarter since the last full search (rows searched alone keep their old entries), a full
     // search costs less and starts every row afresh.
-    const int d = nodes.dim();
     const double a = influence_distance.value();
     const double limit = skin_ / 6.0;
     for (std::size_t i = 0; i < real; ++i) {
-        double u2 = 0.0;
-        for (int c = 0; c < d; ++c) {
-            const double u = nodes.position[c][i] - searched_position_[c][i];
-            u2 += u * u;
-        }
-        const double budget = std::sqrt(u2) + a * std::abs(nodes.diameter[i] - searched_diameter_[i]);
-        if (!(budget <= limit)) rows_due_.push_back(static_cast<NodeIndex>(i));
+        if (!(row_budget(nodes, i, a) <= limit)) rows_due_.push_back(static_cast<NodeIndex>(i));
     }
     if (rows_due_.size() > real / 8 || candidates_.entries() > full_search_entries_ + full_search_entries_ / 4) {
         rows_due_.clear();
