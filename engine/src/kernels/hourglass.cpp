@@ -5,6 +5,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <Eigen/Cholesky>
 #include <Eigen/LU>
 
 #include "gpa/engine/kernels.hpp"
@@ -43,6 +44,72 @@ HourglassFields<D> hourglass_fields(NodeStore& nodes, double lattice_plastic_str
     }
     return f;
 }
+
+namespace {
+
+template <int D>
+using CurvatureMatrix = Eigen::Matrix<double, D, curvature_terms<D>>;
+
+// Lfit and Cfit of the quadratic fit (kernels.hpp, QuadraticHourglassFit) from the Cholesky factor
+// of its moment. False where the pairs do not fix the second derivatives (fewer than D + D (D + 1)
+// / 2 of them, or all near one line or conic: a pivot below 1e-12 of the largest): the affine fit
+// then serves.
+template <int D>
+bool solve_quadratic_fit(const QuadraticHourglassFit<D>& fit, Mat<D>& gradient, CurvatureMatrix<D>& curvature) {
+    constexpr int P = QuadraticHourglassFit<D>::terms;
+    const Eigen::LLT<Eigen::Matrix<double, P, P>, Eigen::Lower> factor(fit.moment);
+    if (factor.info() != Eigen::Success) return false;
+    const auto pivots = factor.matrixLLT().diagonal().cwiseAbs2();
+    if (!(pivots.minCoeff() > 1e-12 * pivots.maxCoeff())) return false;
+    const Eigen::Matrix<double, P, D> solution = factor.solve(fit.difference.transpose());
+    gradient = solution.template topRows<D>().transpose();
+    curvature = solution.template bottomRows<curvature_terms<D>>().transpose();
+    return true;
+}
+
+// A centre's fit, for the damping (r -> dv) and the stiffness form (dX -> dx) alike: the affine
+// map, with the second derivatives where the quadratic fit was asked for and the pairs fix them.
+template <int D>
+struct CentreFit {
+    Mat<D> map = Mat<D>::Zero();
+    CurvatureMatrix<D> curvature = CurvatureMatrix<D>::Zero();
+    double weight = 0.0;  // sum_j w_j
+    double inverse_h = 0.0;
+    bool curved = false;
+    bool found = false;  // false: no fit (too few pairs, or all on a line)
+
+    // The part of a pair's difference the fit does not follow (kernels.hpp, e_ij).
+    Vec<D> error(const Vec<D>& offset, const Vec<D>& difference) const {
+        return curved ? (difference - quadratic_fitted_velocity<D>(map, curvature, offset, inverse_h)).eval()
+                      : hourglass_velocity_error<D>(map, offset, difference);
+    }
+};
+
+// The fit from the sums of pass 1: the quadratic one's when asked for and fixed, else the affine
+// one's (from the quadratic sums' affine part when those were taken); `invert` as in
+// hourglass_centre.
+template <int D, class Invert>
+CentreFit<D> solve_centre_fit(bool quadratic, HourglassFit<D> affine, const QuadraticHourglassFit<D>& sums, double inverse_h,
+                              const Invert& invert) {
+    CentreFit<D> fit;
+    fit.inverse_h = inverse_h;
+    if (quadratic) {
+        fit.curved = solve_quadratic_fit(sums, fit.map, fit.curvature);
+        if (fit.curved) {
+            fit.weight = sums.weight;
+            fit.found = fit.weight > 0.0;
+            return fit;
+        }
+        affine = sums.affine_part();
+    }
+    Mat<D> inverse;
+    fit.found = invert(affine, inverse);
+    if (fit.found) fit.map = affine.difference * inverse;
+    fit.weight = affine.weight;
+    return fit;
+}
+
+}  // namespace
 
 template <int D>
 HourglassPower hourglass_centre(std::span<const NodeIndex> row, std::size_t i, const HourglassFields<D>& f,
@@ -109,6 +176,13 @@ HourglassPower hourglass_centre(std::span<const NodeIndex> row, std::size_t i, c
             for (int b = 0; b < D; ++b) kept.matrix[a * D + b][i] = matrix(a, b);
         }
     };
+    // The quadratic fit's Cfit, zero where the affine fit served (KeptFit::curvature).
+    const auto keep_curvature = [&](const typename HourglassFields<D>::KeptFit& kept, const CentreFit<D>& fit) {
+        if (!kept.curvature[0]) return;
+        for (int a = 0; a < D; ++a) {
+            for (int b = 0; b < curvature_terms<D>; ++b) kept.curvature[a * curvature_terms<D> + b][i] = fit.curved ? fit.curvature(a, b) : 0.0;
+        }
+    };
     const auto kept_matrix = [&](const typename HourglassFields<D>::KeptFit& kept) {
         Mat<D> m;
         for (int a = 0; a < D; ++a) {
@@ -123,27 +197,41 @@ HourglassPower hourglass_centre(std::span<const NodeIndex> row, std::size_t i, c
             for (NodeIndex j : row) out.damping += kept.term(f, j, load(f.position, j) - x_i, real_count);
         }
     } else if (coefficient > 0.0) {
-        // Pass 1: the weighted least-squares velocity gradient of the lattice pairs.
+        // Pass 1: the weighted least-squares velocity gradient of the lattice pairs (with the
+        // second derivatives too for the quadratic fit: kernels.hpp, QuadraticHourglassFit).
         HourglassFit<D> fit;
+        QuadraticHourglassFit<D> quadratic_fit;
+        const double inverse_h = f.quadratic ? 1.0 / f.smallest_h[i] : 0.0;
         count = 0;
-        for (NodeIndex j : row) {
-            if (!controlled_pair(j)) continue;
-            const Vec<D> r = load(f.position, j) - x_i;
-            const double w = hourglass_pair_weight(f.size_weight[j], r.squaredNorm());
-            accumulate_hourglass_fit<D>(r, load(f.velocity, j) - v_i, w, fit);
-            pairs[count++] = {j, r, w};
+        if (f.quadratic) {
+            for (NodeIndex j : row) {
+                if (!controlled_pair(j)) continue;
+                const Vec<D> r = load(f.position, j) - x_i;
+                const double w = hourglass_pair_weight(f.size_weight[j], r.squaredNorm());
+                accumulate_quadratic_hourglass_fit<D>(r, load(f.velocity, j) - v_i, w, inverse_h, quadratic_fit);
+                pairs[count++] = {j, r, w};
+            }
+        } else {
+            for (NodeIndex j : row) {
+                if (!controlled_pair(j)) continue;
+                const Vec<D> r = load(f.position, j) - x_i;
+                const double w = hourglass_pair_weight(f.size_weight[j], r.squaredNorm());
+                accumulate_hourglass_fit<D>(r, load(f.velocity, j) - v_i, w, fit);
+                pairs[count++] = {j, r, w};
+            }
         }
-        Mat<D> inverse;
         no_kept_fit(f.damping_fit);
-        if (invert(fit, inverse)) {
-            const Mat<D> fitted_gradient = fit.difference * inverse;
-            const double kappa = hourglass_damping(coefficient, f.mass[i], f.sound_speed[i], f.smallest_h[i]) / fit.weight;
-            keep(f.damping_fit, kappa, fitted_gradient);
+        const CentreFit<D> fitted = solve_centre_fit<D>(f.quadratic, fit, quadratic_fit, inverse_h, invert);
+        if (fitted.found) {
+            const double kappa = hourglass_damping(coefficient, f.mass[i], f.sound_speed[i], f.smallest_h[i]) / fitted.weight;
+            keep(f.damping_fit, kappa, fitted.map);
+            keep_curvature(f.damping_fit, fitted);
             // Pass 2: F_j = - kappa w_j e_ij on the neighbour, the reaction on the centre.
             for (std::size_t k = 0; k < count; ++k) {
                 const Pair& p = pairs[k];
                 const Vec<D> dv = load(f.velocity, p.j) - v_i;
-                const Vec<D> force_on_j = (-kappa * p.weight) * hourglass_velocity_error<D>(fitted_gradient, p.offset, dv);
+                const Vec<D> error = fitted.error(p.offset, dv);
+                const Vec<D> force_on_j = (-kappa * p.weight) * error;
                 if (scatter) {
                     for (int c = 0; c < D; ++c) f.force[c][p.j] += force_on_j[c];
                 }
@@ -152,42 +240,79 @@ HourglassPower hourglass_centre(std::span<const NodeIndex> row, std::size_t i, c
             }
         }
     }
-    if (f.stiffness > 0.0 && f.connectivity[i] == Connectivity::Fixed && f.use_kept_fits) {
+    // The stiffness form: a fixed centre against the initial lattice (its lattice pairs, weights
+    // 1 / |dX|^2, d0); a controlled variable centre, with a relaxing reference, against that
+    // reference over all its controlled pairs (weights W_j / r^2 as the damping's).
+    const bool fixed_centre = f.connectivity[i] == Connectivity::Fixed;
+    const bool stiff_centre = f.stiffness > 0.0 && (fixed_centre || f.reference_position[0] != nullptr);
+    const std::array<const double*, D>& reference = fixed_centre ? f.initial_position : f.reference_position;
+    // The pair's reference offset and weight; false when the pair takes no part.
+    const auto stiffness_pair = [&](NodeIndex j, const Vec<D>& x0_i, Vec<D>& offset, double& w) {
+        if (fixed_centre) {
+            if (!stiff_pair(j)) return false;
+            offset = load(reference, j) - x0_i;
+            w = hourglass_pair_weight(1.0, offset.squaredNorm());
+            return true;
+        }
+        if (!controlled_pair(j)) return false;
+        offset = load(reference, j) - x0_i;
+        w = hourglass_pair_weight(f.size_weight[j], (load(f.position, j) - x_i).squaredNorm());
+        return true;
+    };
+    // A relaxed centre with the quadratic fit: its map takes the reference's second derivatives too
+    // (kernels.hpp, QuadraticHourglassFit, with r = dX and dv = dx), so that a smoothly bending
+    // flow since the reference stores nothing.
+    const bool stiff_quadratic = stiff_centre && !fixed_centre && f.quadratic;
+    const double stiff_inverse_h = stiff_quadratic ? 1.0 / f.smallest_h[i] : 0.0;
+    if (stiff_centre && f.use_kept_fits) {
         const double k = f.stiffness_fit.scale[i];
         if (k != 0.0) {
-            const Vec<D> x0_i = load(f.initial_position, i);
-            const Mat<D> fitted_map = kept_matrix(f.stiffness_fit);
+            const Vec<D> x0_i = load(reference, i);
+            // The force pass's fit again (an affine one that served has a zero Cfit).
+            CentreFit<D> kept;
+            kept.map = kept_matrix(f.stiffness_fit);
+            kept.curved = stiff_quadratic;
+            kept.inverse_h = stiff_inverse_h;
+            if (stiff_quadratic) {
+                for (int a = 0; a < D; ++a) {
+                    for (int b = 0; b < curvature_terms<D>; ++b) kept.curvature(a, b) = f.stiffness_fit.curvature[a * curvature_terms<D> + b][i];
+                }
+            }
             for (NodeIndex j : row) {
-                if (!stiff_pair(j)) continue;
-                const Vec<D> initial = load(f.initial_position, j) - x0_i;
-                const double w = hourglass_pair_weight(1.0, initial.squaredNorm());
-                const Vec<D> force_on_j = (-k * w) * hourglass_displacement_error<D>(fitted_map, initial, load(f.position, j) - x_i);
+                Vec<D> initial;
+                double w = 0.0;
+                if (!stiffness_pair(j, x0_i, initial, w)) continue;
+                const Vec<D> force_on_j = (-k * w) * kept.error(initial, load(f.position, j) - x_i);
                 out.stiffness += power_of(j, force_on_j, load(f.velocity, j) - v_i);
             }
         }
-    } else if (f.stiffness > 0.0 && f.connectivity[i] == Connectivity::Fixed) {
-        // The stiffness form (kernels.hpp, hourglass_stiffness): the affine map of the initial
-        // lattice pairs that fits their current offsets best, then forces against the rest.
-        const Vec<D> x0_i = load(f.initial_position, i);
+    } else if (stiff_centre) {
+        // The stiffness form (kernels.hpp, hourglass_stiffness): the map of the reference pairs
+        // that fits their current offsets best, then forces against the rest.
+        const Vec<D> x0_i = load(reference, i);
         HourglassFit<D> fit;
+        QuadraticHourglassFit<D> quadratic_fit;
         count = 0;
         for (NodeIndex j : row) {
-            if (!stiff_pair(j)) continue;
-            const Vec<D> initial = load(f.initial_position, j) - x0_i;
-            const double w = hourglass_pair_weight(1.0, initial.squaredNorm());
-            accumulate_hourglass_fit<D>(initial, load(f.position, j) - x_i, w, fit);
+            Vec<D> initial;
+            double w = 0.0;
+            if (!stiffness_pair(j, x0_i, initial, w)) continue;
+            if (stiff_quadratic) {
+                accumulate_quadratic_hourglass_fit<D>(initial, load(f.position, j) - x_i, w, stiff_inverse_h, quadratic_fit);
+            } else {
+                accumulate_hourglass_fit<D>(initial, load(f.position, j) - x_i, w, fit);
+            }
             pairs[count++] = {j, initial, w};
         }
-        Mat<D> inverse;
         no_kept_fit(f.stiffness_fit);
-        if (invert(fit, inverse)) {
-            const Mat<D> fitted_map = fit.difference * inverse;
-            const double k = hourglass_stiffness(f.stiffness, f.mass[i], f.sound_speed[i], f.initial_diameter[i]) / fit.weight;
-            keep(f.stiffness_fit, k, fitted_map);
+        const CentreFit<D> fitted = solve_centre_fit<D>(stiff_quadratic, fit, quadratic_fit, stiff_inverse_h, invert);
+        if (fitted.found) {
+            const double k = hourglass_stiffness(f.stiffness, f.mass[i], f.sound_speed[i], f.initial_diameter[i]) / fitted.weight;
+            keep(f.stiffness_fit, k, fitted.map);
+            keep_curvature(f.stiffness_fit, fitted);
             for (std::size_t e = 0; e < count; ++e) {
                 const Pair& p = pairs[e];
-                const Vec<D> force_on_j = (-k * p.weight) *
-                                          hourglass_displacement_error<D>(fitted_map, p.offset, load(f.position, p.j) - x_i);
+                const Vec<D> force_on_j = (-k * p.weight) * fitted.error(p.offset, load(f.position, p.j) - x_i);
                 if (scatter) {
                     for (int c = 0; c < D; ++c) f.force[c][p.j] += force_on_j[c];
                 }
