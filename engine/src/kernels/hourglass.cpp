@@ -57,7 +57,7 @@ using CurvatureMatrix = Eigen::Matrix<double, D, curvature_terms<D>>;
 template <int D>
 bool solve_quadratic_fit(const QuadraticHourglassFit<D>& fit, Mat<D>& gradient, CurvatureMatrix<D>& curvature) {
     constexpr int P = QuadraticHourglassFit<D>::terms;
-    const Eigen::LLT<Eigen::Matrix<double, P, P>, Eigen::Lower> factor(fit.moment);
+    const Eigen::LLT<Eigen::Matrix<double, P, P>> factor(fit.moment);
     if (factor.info() != Eigen::Success) return false;
     const auto pivots = factor.matrixLLT().diagonal().cwiseAbs2();
     if (!(pivots.minCoeff() > 1e-12 * pivots.maxCoeff())) return false;
@@ -66,6 +66,46 @@ bool solve_quadratic_fit(const QuadraticHourglassFit<D>& fit, Mat<D>& gradient, 
     curvature = solution.template bottomRows<curvature_terms<D>>().transpose();
     return true;
 }
+
+// The quadratic fit's sums over a row by two matrix products, the pairs' bases phi = (r, q(r)),
+// weighted bases and differences gathered first: summed pair by pair, the 9-by-9 moment of 3D
+// does not fit the registers, and each of its 45 terms became a load and a store per pair. One
+// per thread, reused from centre to centre (no allocation once it holds the longest row).
+template <int D>
+class QuadraticSums {
+public:
+    static constexpr int P = QuadraticHourglassFit<D>::terms;
+    void start(std::size_t pairs) {
+        if (static_cast<std::size_t>(basis_.rows()) < pairs) {
+            basis_.resize(static_cast<Eigen::Index>(pairs), P);
+            weighted_.resize(static_cast<Eigen::Index>(pairs), P);
+            difference_.resize(static_cast<Eigen::Index>(pairs), D);
+        }
+        count_ = 0;
+        weight_ = 0.0;
+    }
+    void add(const Vec<D>& r, const Vec<D>& difference, double w, double inverse_h) {
+        const Eigen::Index k = count_++;
+        basis_.row(k).template head<D>() = r.transpose();
+        basis_.row(k).template tail<curvature_terms<D>>() = curvature_basis<D>(r, inverse_h).transpose();
+        weighted_.row(k) = w * basis_.row(k);
+        difference_.row(k) = difference.transpose();
+        weight_ += w;
+    }
+    QuadraticHourglassFit<D> sums() const {
+        QuadraticHourglassFit<D> fit;
+        fit.moment.noalias() = basis_.topRows(count_).transpose() * weighted_.topRows(count_);
+        fit.difference.noalias() = difference_.topRows(count_).transpose() * weighted_.topRows(count_);
+        fit.weight = weight_;
+        return fit;
+    }
+
+private:
+    Eigen::Matrix<double, Eigen::Dynamic, P> basis_, weighted_;
+    Eigen::Matrix<double, Eigen::Dynamic, D> difference_;
+    Eigen::Index count_ = 0;
+    double weight_ = 0.0;
+};
 
 // A centre's fit, for the damping (r -> dv) and the stiffness form (dX -> dx) alike: the affine
 // map, with the second derivatives where the quadratic fit was asked for and the pairs fix them.
@@ -166,6 +206,7 @@ HourglassPower hourglass_centre(std::span<const NodeIndex> row, std::size_t i, c
         double weight;  // w = W_j / r^2 (damping) or 1 / |dX|^2 (stiffness)
     };
     thread_local std::vector<Pair> buffer;
+    thread_local QuadraticSums<D> quadratic_sums;
     if (buffer.size() < row.size()) buffer.resize(row.size());
     Pair* const pairs = buffer.data();
     std::size_t count = 0;
@@ -204,13 +245,15 @@ HourglassPower hourglass_centre(std::span<const NodeIndex> row, std::size_t i, c
         const double inverse_h = f.quadratic ? 1.0 / f.smallest_h[i] : 0.0;
         count = 0;
         if (f.quadratic) {
+            quadratic_sums.start(row.size());
             for (NodeIndex j : row) {
                 if (!controlled_pair(j)) continue;
                 const Vec<D> r = load(f.position, j) - x_i;
                 const double w = hourglass_pair_weight(f.size_weight[j], r.squaredNorm());
-                accumulate_quadratic_hourglass_fit<D>(r, load(f.velocity, j) - v_i, w, inverse_h, quadratic_fit);
+                quadratic_sums.add(r, load(f.velocity, j) - v_i, w, inverse_h);
                 pairs[count++] = {j, r, w};
             }
+            quadratic_fit = quadratic_sums.sums();
         } else {
             for (NodeIndex j : row) {
                 if (!controlled_pair(j)) continue;
@@ -293,17 +336,19 @@ HourglassPower hourglass_centre(std::span<const NodeIndex> row, std::size_t i, c
         HourglassFit<D> fit;
         QuadraticHourglassFit<D> quadratic_fit;
         count = 0;
+        if (stiff_quadratic) quadratic_sums.start(row.size());
         for (NodeIndex j : row) {
             Vec<D> initial;
             double w = 0.0;
             if (!stiffness_pair(j, x0_i, initial, w)) continue;
             if (stiff_quadratic) {
-                accumulate_quadratic_hourglass_fit<D>(initial, load(f.position, j) - x_i, w, stiff_inverse_h, quadratic_fit);
+                quadratic_sums.add(initial, load(f.position, j) - x_i, w, stiff_inverse_h);
             } else {
                 accumulate_hourglass_fit<D>(initial, load(f.position, j) - x_i, w, fit);
             }
             pairs[count++] = {j, initial, w};
         }
+        if (stiff_quadratic) quadratic_fit = quadratic_sums.sums();
         no_kept_fit(f.stiffness_fit);
         const CentreFit<D> fitted = solve_centre_fit<D>(stiff_quadratic, fit, quadratic_fit, stiff_inverse_h, invert);
         if (fitted.found) {

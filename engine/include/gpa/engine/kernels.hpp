@@ -385,8 +385,8 @@ inline Vec<D> quadratic_fitted_velocity(const Mat<D>& gradient, const Eigen::Mat
     return gradient * r + curvature * curvature_basis<D>(r, inverse_h);
 }
 
-// The quadratic fit's normal equations over the pairs: the moment of phi = (r, q(r)) (its lower
-// triangle) and sum_j w_j dv_j phi_j^T.
+// The quadratic fit's normal equations over the pairs: the moment of phi = (r, q(r)) and
+// sum_j w_j dv_j phi_j^T (hourglass.cpp sums them, QuadraticSums).
 template <int D>
 struct QuadraticHourglassFit {
     static constexpr int terms = D + curvature_terms<D>;
@@ -396,27 +396,12 @@ struct QuadraticHourglassFit {
     // The affine fit's sums, which are part of these (where the second derivatives are not fixed).
     HourglassFit<D> affine_part() const {
         HourglassFit<D> fit;
-        fit.moment = moment.template topLeftCorner<D, D>().template selfadjointView<Eigen::Lower>();
+        fit.moment = moment.template topLeftCorner<D, D>();
         fit.difference = difference.template leftCols<D>();
         fit.weight = weight;
         return fit;
     }
 };
-
-template <int D>
-inline void accumulate_quadratic_hourglass_fit(const Vec<D>& r, const Vec<D>& dv, double w, double inverse_h,
-                                               QuadraticHourglassFit<D>& fit) {
-    constexpr int P = QuadraticHourglassFit<D>::terms;
-    Eigen::Matrix<double, P, 1> phi;
-    phi.template head<D>() = r;
-    phi.template tail<curvature_terms<D>>() = curvature_basis<D>(r, inverse_h);
-    for (int a = 0; a < P; ++a) {
-        const double wa = w * phi[a];
-        for (int b = 0; b <= a; ++b) fit.moment(a, b) += wa * phi[b];
-        for (int c = 0; c < D; ++c) fit.difference(c, a) += wa * dv[c];
-    }
-    fit.weight += w;
-}
 
 // The weight of a lattice pair in the fit and the force: w = W_j / r^2.
 inline double hourglass_pair_weight(double size_weight_j, double r_squared) { return size_weight_j / r_squared; }
