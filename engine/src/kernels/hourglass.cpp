@@ -1,5 +1,6 @@
 #include "gpa/engine/hourglass.hpp"
 
+#include <type_traits>
 #include <vector>
 
 #include <tbb/blocked_range.h>
@@ -75,6 +76,10 @@ template <int D>
 class QuadraticSums {
 public:
     static constexpr int P = QuadraticHourglassFit<D>::terms;
+    static QuadraticSums& of_this_thread() {
+        thread_local QuadraticSums sums;
+        return sums;
+    }
     void start(std::size_t pairs) {
         if (static_cast<std::size_t>(basis_.rows()) < pairs) {
             basis_.resize(static_cast<Eigen::Index>(pairs), P);
@@ -111,19 +116,35 @@ private:
 // map, with the second derivatives where the quadratic fit was asked for and the pairs fix them.
 template <int D>
 struct CentreFit {
-    Mat<D> map = Mat<D>::Zero();
-    CurvatureMatrix<D> curvature = CurvatureMatrix<D>::Zero();
+    Mat<D> map;
+    CurvatureMatrix<D> curvature;  // set where curved
     double weight = 0.0;  // sum_j w_j
     double inverse_h = 0.0;
     bool curved = false;
     bool found = false;  // false: no fit (too few pairs, or all on a line)
 
-    // The part of a pair's difference the fit does not follow (kernels.hpp, e_ij).
+    // The part of a pair's difference the fit does not follow (kernels.hpp, e_ij), with the second
+    // derivatives or without: the callers choose once per centre, so that the affine loop is the
+    // one it was (a branch per pair and the curvature's registers slowed the 3D force pass by 10 %).
+    template <bool Curved>
     Vec<D> error(const Vec<D>& offset, const Vec<D>& difference) const {
-        return curved ? (difference - quadratic_fitted_velocity<D>(map, curvature, offset, inverse_h)).eval()
-                      : hourglass_velocity_error<D>(map, offset, difference);
+        if constexpr (Curved) {
+            return difference - quadratic_fitted_velocity<D>(map, curvature, offset, inverse_h);
+        } else {
+            return hourglass_velocity_error<D>(map, offset, difference);
+        }
     }
 };
+
+// Runs `walk` with the fit's curvature on or off as a constant.
+template <int D, class Walk>
+void with_fit_kind(const CentreFit<D>& fit, Walk&& walk) {
+    if (fit.curved) {
+        walk(std::true_type{});
+    } else {
+        walk(std::false_type{});
+    }
+}
 
 // The fit from the sums of pass 1: the quadratic one's when asked for and fixed, else the affine
 // one's (from the quadratic sums' affine part when those were taken); `invert` as in
@@ -206,7 +227,6 @@ HourglassPower hourglass_centre(std::span<const NodeIndex> row, std::size_t i, c
         double weight;  // w = W_j / r^2 (damping) or 1 / |dX|^2 (stiffness)
     };
     thread_local std::vector<Pair> buffer;
-    thread_local QuadraticSums<D> quadratic_sums;
     if (buffer.size() < row.size()) buffer.resize(row.size());
     Pair* const pairs = buffer.data();
     std::size_t count = 0;
@@ -245,6 +265,7 @@ HourglassPower hourglass_centre(std::span<const NodeIndex> row, std::size_t i, c
         const double inverse_h = f.quadratic ? 1.0 / f.smallest_h[i] : 0.0;
         count = 0;
         if (f.quadratic) {
+            QuadraticSums<D>& quadratic_sums = QuadraticSums<D>::of_this_thread();
             quadratic_sums.start(row.size());
             for (NodeIndex j : row) {
                 if (!controlled_pair(j)) continue;
@@ -270,17 +291,18 @@ HourglassPower hourglass_centre(std::span<const NodeIndex> row, std::size_t i, c
             keep(f.damping_fit, kappa, fitted.map);
             keep_curvature(f.damping_fit, fitted);
             // Pass 2: F_j = - kappa w_j e_ij on the neighbour, the reaction on the centre.
-            for (std::size_t k = 0; k < count; ++k) {
-                const Pair& p = pairs[k];
-                const Vec<D> dv = load(f.velocity, p.j) - v_i;
-                const Vec<D> error = fitted.error(p.offset, dv);
-                const Vec<D> force_on_j = (-kappa * p.weight) * error;
-                if (scatter) {
-                    for (int c = 0; c < D; ++c) f.force[c][p.j] += force_on_j[c];
+            with_fit_kind(fitted, [&](auto curved) {
+                for (std::size_t k = 0; k < count; ++k) {
+                    const Pair& p = pairs[k];
+                    const Vec<D> dv = load(f.velocity, p.j) - v_i;
+                    const Vec<D> force_on_j = (-kappa * p.weight) * fitted.template error<decltype(curved)::value>(p.offset, dv);
+                    if (scatter) {
+                        for (int c = 0; c < D; ++c) f.force[c][p.j] += force_on_j[c];
+                    }
+                    on_centre -= force_on_j;
+                    out.damping += power_of(p.j, force_on_j, dv);
                 }
-                on_centre -= force_on_j;
-                out.damping += power_of(p.j, force_on_j, dv);
-            }
+            });
         }
     }
     // The stiffness form: a fixed centre against the initial lattice (its lattice pairs, weights
@@ -321,13 +343,15 @@ HourglassPower hourglass_centre(std::span<const NodeIndex> row, std::size_t i, c
                     for (int b = 0; b < curvature_terms<D>; ++b) kept.curvature(a, b) = f.stiffness_fit.curvature[a * curvature_terms<D> + b][i];
                 }
             }
-            for (NodeIndex j : row) {
-                Vec<D> initial;
-                double w = 0.0;
-                if (!stiffness_pair(j, x0_i, initial, w)) continue;
-                const Vec<D> force_on_j = (-k * w) * kept.error(initial, load(f.position, j) - x_i);
-                out.stiffness += power_of(j, force_on_j, load(f.velocity, j) - v_i);
-            }
+            with_fit_kind(kept, [&](auto curved) {
+                for (NodeIndex j : row) {
+                    Vec<D> initial;
+                    double w = 0.0;
+                    if (!stiffness_pair(j, x0_i, initial, w)) continue;
+                    const Vec<D> force_on_j = (-k * w) * kept.template error<decltype(curved)::value>(initial, load(f.position, j) - x_i);
+                    out.stiffness += power_of(j, force_on_j, load(f.velocity, j) - v_i);
+                }
+            });
         }
     } else if (stiff_centre) {
         // The stiffness form (kernels.hpp, hourglass_stiffness): the map of the reference pairs
@@ -336,34 +360,38 @@ HourglassPower hourglass_centre(std::span<const NodeIndex> row, std::size_t i, c
         HourglassFit<D> fit;
         QuadraticHourglassFit<D> quadratic_fit;
         count = 0;
-        if (stiff_quadratic) quadratic_sums.start(row.size());
+        QuadraticSums<D>* quadratic_sums = stiff_quadratic ? &QuadraticSums<D>::of_this_thread() : nullptr;
+        if (quadratic_sums) quadratic_sums->start(row.size());
         for (NodeIndex j : row) {
             Vec<D> initial;
             double w = 0.0;
             if (!stiffness_pair(j, x0_i, initial, w)) continue;
-            if (stiff_quadratic) {
-                quadratic_sums.add(initial, load(f.position, j) - x_i, w, stiff_inverse_h);
+            if (quadratic_sums) {
+                quadratic_sums->add(initial, load(f.position, j) - x_i, w, stiff_inverse_h);
             } else {
                 accumulate_hourglass_fit<D>(initial, load(f.position, j) - x_i, w, fit);
             }
             pairs[count++] = {j, initial, w};
         }
-        if (stiff_quadratic) quadratic_fit = quadratic_sums.sums();
+        if (quadratic_sums) quadratic_fit = quadratic_sums->sums();
         no_kept_fit(f.stiffness_fit);
         const CentreFit<D> fitted = solve_centre_fit<D>(stiff_quadratic, fit, quadratic_fit, stiff_inverse_h, invert);
         if (fitted.found) {
             const double k = hourglass_stiffness(f.stiffness, f.mass[i], f.sound_speed[i], f.initial_diameter[i]) / fitted.weight;
             keep(f.stiffness_fit, k, fitted.map);
             keep_curvature(f.stiffness_fit, fitted);
-            for (std::size_t e = 0; e < count; ++e) {
-                const Pair& p = pairs[e];
-                const Vec<D> force_on_j = (-k * p.weight) * fitted.error(p.offset, load(f.position, p.j) - x_i);
-                if (scatter) {
-                    for (int c = 0; c < D; ++c) f.force[c][p.j] += force_on_j[c];
+            with_fit_kind(fitted, [&](auto curved) {
+                for (std::size_t e = 0; e < count; ++e) {
+                    const Pair& p = pairs[e];
+                    const Vec<D> force_on_j =
+                        (-k * p.weight) * fitted.template error<decltype(curved)::value>(p.offset, load(f.position, p.j) - x_i);
+                    if (scatter) {
+                        for (int c = 0; c < D; ++c) f.force[c][p.j] += force_on_j[c];
+                    }
+                    on_centre -= force_on_j;
+                    out.stiffness += power_of(p.j, force_on_j, load(f.velocity, p.j) - v_i);
                 }
-                on_centre -= force_on_j;
-                out.stiffness += power_of(p.j, force_on_j, load(f.velocity, p.j) - v_i);
-            }
+            });
         }
     }
     if (scatter) {

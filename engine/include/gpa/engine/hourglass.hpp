@@ -165,8 +165,8 @@ public:
         // fused walk took twice the time of the two walks it replaced).
         const double w = hourglass_pair_weight(f.size_weight[j], r.squaredNorm());
         const double scale = -kappa_ * w;
-        const Vec<D> fitted = quadratic_ ? quadratic_fitted_velocity<D>(fitted_gradient_, curvature_, r, inverse_h_)
-                                         : (fitted_gradient_ * r).eval();
+        Vec<D> fitted = fitted_gradient_ * r;
+        if (quadratic_) fitted += curvature_ * curvature_basis<D>(r, inverse_h_);  // as quadratic_fitted_velocity sums them
         double power = 0.0;
         for (int a = 0; a < D; ++a) {
             const double dv = f.velocity[a][j] - v_i_[a];
