@@ -400,12 +400,10 @@ void stress_power_impl(const CompressedRows& lists, const ForceFields<G::dim>& f
             if (hourglass) {
                 hourglass->power[i] = damping_power;
                 if (hourglass->stiffness_power) {
-                    // The stiffness form's power (fixed centres, and flowing ones with a relaxing reference) in
-                    // a walk of its own: coefficient 0
+                    // The stiffness form's power (fixed centres only) in a walk of its own: coefficient 0
                     // leaves the damping out of hourglass_centre.
                     hourglass->stiffness_power[i] =
-                        hourglass->stiffness > 0.0 &&
-                                (hourglass->connectivity[i] == Connectivity::Fixed || hourglass->reference_position[0] != nullptr)
+                        hourglass->stiffness > 0.0 && hourglass->connectivity[i] == Connectivity::Fixed
                             ? hourglass_centre<D>(row, i, *hourglass, n, 0.0).stiffness
                             : 0.0;
                 }

@@ -41,20 +41,12 @@ struct HourglassFields {
     // Variable-connectivity centres are controlled while their equivalent plastic strain is below
     // this (the lattice regime, where the mode lives: see apply_hourglass_control); fixed ones always.
     double lattice_plastic_strain = 0.0;
-    // The fit with the second derivatives (SolverOptions::hourglass_fit; kernels.hpp,
-    // QuadraticHourglassFit) for the damping and for the stiffness form on flowing centres; the
-    // affine fit otherwise (and always for fixed centres' stiffness, against the lattice).
-    bool quadratic = false;
     // The stiffness form (kernels.hpp, hourglass_stiffness): C_hs > 0 adds, on fixed centres, forces
     // against the non-affine part of the lattice pairs' displacement since t = 0 (pairs of two fixed
     // nodes of one body), from the initial positions and diameters.
     double stiffness = 0.0;  // C_hs; 0 = none
     std::array<const double*, D> initial_position{};
     const double* initial_diameter = nullptr;
-    // Set with SolverOptions::hourglass_stiffness_relaxation: the stiffness form acts on the
-    // controlled variable centres too, against the relaxing reference (NodeStore::reference_position)
-    // over all their controlled pairs, weighed as the damping weighs them.
-    std::array<const double*, D> reference_position{};
     // outputs
     std::array<double*, D> force{};  // added to; all null: only the power is computed
     double* power = nullptr;         // per centre: the power of its damping forces (<= 0), W
@@ -71,9 +63,6 @@ struct HourglassFields {
     struct KeptFit {
         double* scale = nullptr;
         std::array<double*, D * D> matrix{};
-        // The quadratic fit's Cfit (D * curvature_terms entries, row-major; zero where the affine fit
-        // served): set with `quadratic` (for the stiffness form, read on flowing centres only).
-        std::array<double*, D * curvature_terms<D>> curvature{};
     };
     KeptFit damping_fit, stiffness_fit;  // written when set and use_kept_fits is false
     bool use_kept_fits = false;          // read the kept fits instead of fitting (no forces are added then)
@@ -139,13 +128,6 @@ public:
         for (int a = 0; a < D; ++a) {
             for (int b = 0; b < D; ++b) fitted_gradient_(a, b) = f.damping_fit.matrix[a * D + b][i];
         }
-        if (f.quadratic) {
-            quadratic_ = true;
-            inverse_h_ = 1.0 / f.smallest_h[i];
-            for (int a = 0; a < D; ++a) {
-                for (int b = 0; b < curvature_terms<D>; ++b) curvature_(a, b) = f.damping_fit.curvature[a * curvature_terms<D> + b][i];
-            }
-        }
         other_velocity_ = f.power_velocity[0] != nullptr;
         for (int c = 0; c < D; ++c) {
             v_i_[c] = f.velocity[c][i];
@@ -165,8 +147,7 @@ public:
         // fused walk took twice the time of the two walks it replaced).
         const double w = hourglass_pair_weight(f.size_weight[j], r.squaredNorm());
         const double scale = -kappa_ * w;
-        Vec<D> fitted = fitted_gradient_ * r;
-        if (quadratic_) fitted += curvature_ * curvature_basis<D>(r, inverse_h_);  // as quadratic_fitted_velocity sums them
+        const Vec<D> fitted = fitted_gradient_ * r;
         double power = 0.0;
         for (int a = 0; a < D; ++a) {
             const double dv = f.velocity[a][j] - v_i_[a];
@@ -182,9 +163,6 @@ private:
     double kappa_ = 0.0;
     bool other_velocity_ = false;
     Mat<D> fitted_gradient_ = Mat<D>::Zero();
-    bool quadratic_ = false;
-    double inverse_h_ = 0.0;
-    Eigen::Matrix<double, D, curvature_terms<D>> curvature_ = Eigen::Matrix<double, D, curvature_terms<D>>::Zero();
     Vec<D> v_i_ = Vec<D>::Zero(), w_i_ = Vec<D>::Zero();
 };
 
