@@ -354,7 +354,9 @@ void stress_difference_impl(const CompressedRows& lists, const ScatterPlan& plan
     for_each_coloured_centre(plan, centre);
 }
 
-template <class G, class W>
+// `CurvedDamping`: the hourglass damping's kept fits may have second derivatives (the quadratic
+// fit; KeptDampingPower), chosen once for the pass.
+template <class G, class W, bool CurvedDamping>
 void stress_power_impl(const CompressedRows& lists, const ForceFields<G::dim>& f,
                        const std::array<const double*, G::dim>& velocity, std::size_t n, double* power,
                        double* viscous_power, const HourglassFields<G::dim>* hourglass, double hourglass_coefficient) {
@@ -372,8 +374,8 @@ void stress_power_impl(const CompressedRows& lists, const ForceFields<G::dim>& f
             Mat<D> difference = Mat<D>::Zero();
             // The hourglass damping's power in the same walk of the row (hourglass.hpp,
             // KeptDampingPower): the same numbers as a walk of its own.
-            KeptDampingPower<D> damping;
-            if (hourglass) damping = KeptDampingPower<D>(*hourglass, i, n, hourglass_coefficient);
+            KeptDampingPower<D, CurvedDamping> damping;
+            if (hourglass) damping = KeptDampingPower<D, CurvedDamping>(*hourglass, i, n, hourglass_coefficient);
             double damping_power = 0.0;
             const std::size_t first = lists.offsets[i];
             const auto row = lists.row(i);
@@ -400,10 +402,12 @@ void stress_power_impl(const CompressedRows& lists, const ForceFields<G::dim>& f
             if (hourglass) {
                 hourglass->power[i] = damping_power;
                 if (hourglass->stiffness_power) {
-                    // The stiffness form's power (fixed centres only) in a walk of its own: coefficient 0
-                    // leaves the damping out of hourglass_centre.
+                    // The stiffness form's power (fixed centres, and flowing ones with a relaxing
+                    // reference) in a walk of its own: coefficient 0 leaves the damping out of
+                    // hourglass_centre.
                     hourglass->stiffness_power[i] =
-                        hourglass->stiffness > 0.0 && hourglass->connectivity[i] == Connectivity::Fixed
+                        hourglass->stiffness > 0.0 &&
+                                (hourglass->connectivity[i] == Connectivity::Fixed || hourglass->reference_position[0] != nullptr)
                             ? hourglass_centre<D>(row, i, *hourglass, n, 0.0).stiffness
                             : 0.0;
                 }
@@ -419,8 +423,13 @@ void compute_stress_power(const CompressedRows& lists, WeightKind weight, const 
                           const std::array<const double*, G::dim>& velocity, std::size_t real_count, double* power,
                           double* viscous_power, const HourglassFields<G::dim>* hourglass, double hourglass_coefficient) {
     dispatch_weight(weight, [&](auto w) {
-        stress_power_impl<G, decltype(w)>(lists, f, velocity, real_count, power, viscous_power, hourglass,
-                                          hourglass_coefficient);
+        if (hourglass && hourglass->quadratic) {
+            stress_power_impl<G, decltype(w), true>(lists, f, velocity, real_count, power, viscous_power, hourglass,
+                                                    hourglass_coefficient);
+        } else {
+            stress_power_impl<G, decltype(w), false>(lists, f, velocity, real_count, power, viscous_power, hourglass,
+                                                     hourglass_coefficient);
+        }
     });
 }
 

@@ -1,10 +1,12 @@
 #include "gpa/engine/hourglass.hpp"
 
+#include <type_traits>
 #include <vector>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <Eigen/Cholesky>
 #include <Eigen/LU>
 
 #include "gpa/engine/kernels.hpp"
@@ -44,9 +46,142 @@ HourglassFields<D> hourglass_fields(NodeStore& nodes, double lattice_plastic_str
     return f;
 }
 
+namespace {
+
 template <int D>
-HourglassPower hourglass_centre(std::span<const NodeIndex> row, std::size_t i, const HourglassFields<D>& f,
-                                std::size_t real_count, double coefficient) {
+using CurvatureMatrix = Eigen::Matrix<double, D, curvature_terms<D>>;
+
+// Lfit and Cfit of the quadratic fit (kernels.hpp, QuadraticHourglassFit) from the Cholesky factor
+// of its moment. False where the pairs do not fix the second derivatives (fewer than D + D (D + 1)
+// / 2 of them, or all near one line or conic: a pivot below 1e-12 of the largest): the affine fit
+// then serves.
+template <int D>
+bool solve_quadratic_fit(const QuadraticHourglassFit<D>& fit, Mat<D>& gradient, CurvatureMatrix<D>& curvature) {
+    constexpr int P = QuadraticHourglassFit<D>::terms;
+    const Eigen::LLT<Eigen::Matrix<double, P, P>> factor(fit.moment);
+    if (factor.info() != Eigen::Success) return false;
+    const auto pivots = factor.matrixLLT().diagonal().cwiseAbs2();
+    if (!(pivots.minCoeff() > 1e-12 * pivots.maxCoeff())) return false;
+    const Eigen::Matrix<double, P, D> solution = factor.solve(fit.difference.transpose());
+    gradient = solution.template topRows<D>().transpose();
+    curvature = solution.template bottomRows<curvature_terms<D>>().transpose();
+    return true;
+}
+
+// The quadratic fit's sums over a row by two matrix products, the pairs' bases phi = (r, q(r)),
+// weighted bases and differences gathered first: summed pair by pair, the 9-by-9 moment of 3D
+// does not fit the registers, and each of its 45 terms became a load and a store per pair. One
+// per thread, reused from centre to centre (no allocation once it holds the longest row).
+template <int D>
+class QuadraticSums {
+public:
+    static constexpr int P = QuadraticHourglassFit<D>::terms;
+    static QuadraticSums& of_this_thread() {
+        thread_local QuadraticSums sums;
+        return sums;
+    }
+    void start(std::size_t pairs) {
+        if (static_cast<std::size_t>(basis_.rows()) < pairs) {
+            basis_.resize(static_cast<Eigen::Index>(pairs), P);
+            weighted_.resize(static_cast<Eigen::Index>(pairs), P);
+            difference_.resize(static_cast<Eigen::Index>(pairs), D);
+        }
+        count_ = 0;
+        weight_ = 0.0;
+    }
+    void add(const Vec<D>& r, const Vec<D>& difference, double w, double inverse_h) {
+        const Eigen::Index k = count_++;
+        basis_.row(k).template head<D>() = r.transpose();
+        basis_.row(k).template tail<curvature_terms<D>>() = curvature_basis<D>(r, inverse_h).transpose();
+        weighted_.row(k) = w * basis_.row(k);
+        difference_.row(k) = difference.transpose();
+        weight_ += w;
+    }
+    QuadraticHourglassFit<D> sums() const {
+        QuadraticHourglassFit<D> fit;
+        fit.moment.noalias() = basis_.topRows(count_).transpose() * weighted_.topRows(count_);
+        fit.difference.noalias() = difference_.topRows(count_).transpose() * weighted_.topRows(count_);
+        fit.weight = weight_;
+        return fit;
+    }
+
+private:
+    Eigen::Matrix<double, Eigen::Dynamic, P> basis_, weighted_;
+    Eigen::Matrix<double, Eigen::Dynamic, D> difference_;
+    Eigen::Index count_ = 0;
+    double weight_ = 0.0;
+};
+
+// A centre's fit, for the damping (r -> dv) and the stiffness form (dX -> dx) alike: the affine
+// map, with the second derivatives where the quadratic fit was asked for and the pairs fix them.
+template <int D>
+struct CentreFit {
+    Mat<D> map;
+    CurvatureMatrix<D> curvature;  // set where curved
+    double weight = 0.0;  // sum_j w_j
+    double inverse_h = 0.0;
+    bool curved = false;
+    bool found = false;  // false: no fit (too few pairs, or all on a line)
+
+    // The part of a pair's difference the fit does not follow (kernels.hpp, e_ij), with the second
+    // derivatives or without: the callers choose once per centre, so that the affine loop is the
+    // one it was (a branch per pair and the curvature's registers slowed the 3D force pass by 10 %).
+    template <bool Curved>
+    Vec<D> error(const Vec<D>& offset, const Vec<D>& difference) const {
+        if constexpr (Curved) {
+            return difference - quadratic_fitted_velocity<D>(map, curvature, offset, inverse_h);
+        } else {
+            return hourglass_velocity_error<D>(map, offset, difference);
+        }
+    }
+};
+
+// Runs `walk` with the fit's curvature on or off as a constant; always off in the affine control
+// (General false: see centre_control).
+template <bool General, int D, class Walk>
+void with_fit_kind(const CentreFit<D>& fit, Walk&& walk) {
+    if constexpr (General) {
+        if (fit.curved) {
+            walk(std::true_type{});
+            return;
+        }
+    }
+    walk(std::false_type{});
+}
+
+// The affine fit from the sums of pass 1; `invert` as in centre_control.
+template <int D, class Invert>
+CentreFit<D> affine_centre_fit(const HourglassFit<D>& affine, const Invert& invert) {
+    CentreFit<D> fit;
+    Mat<D> inverse;
+    fit.found = invert(affine, inverse);
+    if (fit.found) fit.map = affine.difference * inverse;
+    fit.weight = affine.weight;
+    return fit;
+}
+
+// The quadratic fit from its sums where the pairs fix the second derivatives, else the affine fit
+// from the same sums' affine part.
+template <int D, class Invert>
+CentreFit<D> quadratic_centre_fit(const QuadraticHourglassFit<D>& sums, double inverse_h, const Invert& invert) {
+    CentreFit<D> fit;
+    fit.curved = solve_quadratic_fit(sums, fit.map, fit.curvature);
+    if (!fit.curved) return affine_centre_fit<D>(sums.affine_part(), invert);
+    fit.inverse_h = inverse_h;
+    fit.weight = sums.weight;
+    fit.found = fit.weight > 0.0;
+    return fit;
+}
+
+// One centre of the control (hourglass.hpp, hourglass_centre). `General` false: the affine fit
+// and the stiffness on fixed centres only, HourglassFields::quadratic and reference_position
+// ignored; that instantiation is the control of the defaults, which the options below leave as it
+// was (compiled inside one function with them, their state and branches slowed its force pass by
+// 12-31 % and its booking by 18-49 %). `General` true: the quadratic fit when asked for, and the
+// stiffness on flowing centres against their relaxing reference.
+template <int D, bool General>
+HourglassPower centre_control(std::span<const NodeIndex> row, std::size_t i, const HourglassFields<D>& f,
+                              std::size_t real_count, double coefficient) {
     const auto load = [](const std::array<const double*, D>& field, std::size_t k) {
         Vec<D> v;
         for (int c = 0; c < D; ++c) v[c] = field[c][k];
@@ -109,6 +244,13 @@ HourglassPower hourglass_centre(std::span<const NodeIndex> row, std::size_t i, c
             for (int b = 0; b < D; ++b) kept.matrix[a * D + b][i] = matrix(a, b);
         }
     };
+    // The quadratic fit's Cfit, zero where the affine fit served (KeptFit::curvature).
+    const auto keep_curvature = [&](const typename HourglassFields<D>::KeptFit& kept, const CentreFit<D>& fit) {
+        if (!General || !kept.curvature[0]) return;
+        for (int a = 0; a < D; ++a) {
+            for (int b = 0; b < curvature_terms<D>; ++b) kept.curvature[a * curvature_terms<D> + b][i] = fit.curved ? fit.curvature(a, b) : 0.0;
+        }
+    };
     const auto kept_matrix = [&](const typename HourglassFields<D>::KeptFit& kept) {
         Mat<D> m;
         for (int a = 0; a < D; ++a) {
@@ -118,82 +260,152 @@ HourglassPower hourglass_centre(std::span<const NodeIndex> row, std::size_t i, c
     };
     if (coefficient > 0.0 && f.use_kept_fits) {
         // The force pass's fit: its forces again, pair by pair as in pass 2 below, for their power.
-        const KeptDampingPower<D> kept(f, i, real_count, coefficient);
-        if (kept.active()) {
-            for (NodeIndex j : row) out.damping += kept.term(f, j, load(f.position, j) - x_i, real_count);
+        const auto kept_power = [&](auto curved) {
+            const KeptDampingPower<D, decltype(curved)::value> kept(f, i, real_count, coefficient);
+            if (kept.active()) {
+                for (NodeIndex j : row) out.damping += kept.term(f, j, load(f.position, j) - x_i, real_count);
+            }
+        };
+        if (General && f.quadratic) {
+            kept_power(std::bool_constant<General>{});
+        } else {
+            kept_power(std::false_type{});
         }
     } else if (coefficient > 0.0) {
-        // Pass 1: the weighted least-squares velocity gradient of the lattice pairs.
-        HourglassFit<D> fit;
+        // Pass 1: the weighted least-squares velocity gradient of the lattice pairs (with the
+        // second derivatives too for the quadratic fit: kernels.hpp, QuadraticHourglassFit).
+        CentreFit<D> fitted;
         count = 0;
-        for (NodeIndex j : row) {
-            if (!controlled_pair(j)) continue;
-            const Vec<D> r = load(f.position, j) - x_i;
-            const double w = hourglass_pair_weight(f.size_weight[j], r.squaredNorm());
-            accumulate_hourglass_fit<D>(r, load(f.velocity, j) - v_i, w, fit);
-            pairs[count++] = {j, r, w};
-        }
-        Mat<D> inverse;
-        no_kept_fit(f.damping_fit);
-        if (invert(fit, inverse)) {
-            const Mat<D> fitted_gradient = fit.difference * inverse;
-            const double kappa = hourglass_damping(coefficient, f.mass[i], f.sound_speed[i], f.smallest_h[i]) / fit.weight;
-            keep(f.damping_fit, kappa, fitted_gradient);
-            // Pass 2: F_j = - kappa w_j e_ij on the neighbour, the reaction on the centre.
-            for (std::size_t k = 0; k < count; ++k) {
-                const Pair& p = pairs[k];
-                const Vec<D> dv = load(f.velocity, p.j) - v_i;
-                const Vec<D> force_on_j = (-kappa * p.weight) * hourglass_velocity_error<D>(fitted_gradient, p.offset, dv);
-                if (scatter) {
-                    for (int c = 0; c < D; ++c) f.force[c][p.j] += force_on_j[c];
-                }
-                on_centre -= force_on_j;
-                out.damping += power_of(p.j, force_on_j, dv);
+        if (General && f.quadratic) {
+            const double inverse_h = 1.0 / f.smallest_h[i];
+            QuadraticSums<D>& quadratic_sums = QuadraticSums<D>::of_this_thread();
+            quadratic_sums.start(row.size());
+            for (NodeIndex j : row) {
+                if (!controlled_pair(j)) continue;
+                const Vec<D> r = load(f.position, j) - x_i;
+                const double w = hourglass_pair_weight(f.size_weight[j], r.squaredNorm());
+                quadratic_sums.add(r, load(f.velocity, j) - v_i, w, inverse_h);
+                pairs[count++] = {j, r, w};
             }
+            fitted = quadratic_centre_fit<D>(quadratic_sums.sums(), inverse_h, invert);
+        } else {
+            HourglassFit<D> fit;
+            for (NodeIndex j : row) {
+                if (!controlled_pair(j)) continue;
+                const Vec<D> r = load(f.position, j) - x_i;
+                const double w = hourglass_pair_weight(f.size_weight[j], r.squaredNorm());
+                accumulate_hourglass_fit<D>(r, load(f.velocity, j) - v_i, w, fit);
+                pairs[count++] = {j, r, w};
+            }
+            fitted = affine_centre_fit<D>(fit, invert);
+        }
+        no_kept_fit(f.damping_fit);
+        if (fitted.found) {
+            const double kappa = hourglass_damping(coefficient, f.mass[i], f.sound_speed[i], f.smallest_h[i]) / fitted.weight;
+            keep(f.damping_fit, kappa, fitted.map);
+            keep_curvature(f.damping_fit, fitted);
+            // Pass 2: F_j = - kappa w_j e_ij on the neighbour, the reaction on the centre.
+            with_fit_kind<General>(fitted, [&](auto curved) {
+                for (std::size_t k = 0; k < count; ++k) {
+                    const Pair& p = pairs[k];
+                    const Vec<D> dv = load(f.velocity, p.j) - v_i;
+                    const Vec<D> force_on_j = (-kappa * p.weight) * fitted.template error<decltype(curved)::value>(p.offset, dv);
+                    if (scatter) {
+                        for (int c = 0; c < D; ++c) f.force[c][p.j] += force_on_j[c];
+                    }
+                    on_centre -= force_on_j;
+                    out.damping += power_of(p.j, force_on_j, dv);
+                }
+            });
         }
     }
-    if (f.stiffness > 0.0 && f.connectivity[i] == Connectivity::Fixed && f.use_kept_fits) {
+    // The stiffness form: a fixed centre against the initial lattice (its lattice pairs, weights
+    // 1 / |dX|^2, d0); a controlled variable centre, with a relaxing reference, against that
+    // reference over all its controlled pairs (weights W_j / r^2 as the damping's).
+    const bool fixed_centre = f.connectivity[i] == Connectivity::Fixed;
+    const bool relaxed_centre = General && !fixed_centre && f.reference_position[0] != nullptr;
+    const bool stiff_centre = f.stiffness > 0.0 && (fixed_centre || relaxed_centre);
+    const std::array<const double*, D>& reference = relaxed_centre ? f.reference_position : f.initial_position;
+    // The pair's reference offset and weight; false when the pair takes no part.
+    const auto stiffness_pair = [&](NodeIndex j, const Vec<D>& x0_i, Vec<D>& offset, double& w) {
+        if (!relaxed_centre) {
+            if (!stiff_pair(j)) return false;
+            offset = load(reference, j) - x0_i;
+            w = hourglass_pair_weight(1.0, offset.squaredNorm());
+            return true;
+        }
+        if (!controlled_pair(j)) return false;
+        offset = load(reference, j) - x0_i;
+        w = hourglass_pair_weight(f.size_weight[j], (load(f.position, j) - x_i).squaredNorm());
+        return true;
+    };
+    // A relaxed centre with the quadratic fit: its map takes the reference's second derivatives too
+    // (kernels.hpp, QuadraticHourglassFit, with r = dX and dv = dx), so that a smoothly bending
+    // flow since the reference stores nothing.
+    const bool stiff_quadratic = stiff_centre && relaxed_centre && f.quadratic;
+    const double stiff_inverse_h = stiff_quadratic ? 1.0 / f.smallest_h[i] : 0.0;
+    if (stiff_centre && f.use_kept_fits) {
         const double k = f.stiffness_fit.scale[i];
         if (k != 0.0) {
-            const Vec<D> x0_i = load(f.initial_position, i);
-            const Mat<D> fitted_map = kept_matrix(f.stiffness_fit);
-            for (NodeIndex j : row) {
-                if (!stiff_pair(j)) continue;
-                const Vec<D> initial = load(f.initial_position, j) - x0_i;
-                const double w = hourglass_pair_weight(1.0, initial.squaredNorm());
-                const Vec<D> force_on_j = (-k * w) * hourglass_displacement_error<D>(fitted_map, initial, load(f.position, j) - x_i);
-                out.stiffness += power_of(j, force_on_j, load(f.velocity, j) - v_i);
+            const Vec<D> x0_i = load(reference, i);
+            // The force pass's fit again (an affine one that served has a zero Cfit).
+            CentreFit<D> kept;
+            kept.map = kept_matrix(f.stiffness_fit);
+            kept.curved = stiff_quadratic;
+            kept.inverse_h = stiff_inverse_h;
+            if (stiff_quadratic) {
+                for (int a = 0; a < D; ++a) {
+                    for (int b = 0; b < curvature_terms<D>; ++b) kept.curvature(a, b) = f.stiffness_fit.curvature[a * curvature_terms<D> + b][i];
+                }
             }
+            with_fit_kind<General>(kept, [&](auto curved) {
+                for (NodeIndex j : row) {
+                    Vec<D> initial;
+                    double w = 0.0;
+                    if (!stiffness_pair(j, x0_i, initial, w)) continue;
+                    const Vec<D> force_on_j = (-k * w) * kept.template error<decltype(curved)::value>(initial, load(f.position, j) - x_i);
+                    out.stiffness += power_of(j, force_on_j, load(f.velocity, j) - v_i);
+                }
+            });
         }
-    } else if (f.stiffness > 0.0 && f.connectivity[i] == Connectivity::Fixed) {
-        // The stiffness form (kernels.hpp, hourglass_stiffness): the affine map of the initial
-        // lattice pairs that fits their current offsets best, then forces against the rest.
-        const Vec<D> x0_i = load(f.initial_position, i);
+    } else if (stiff_centre) {
+        // The stiffness form (kernels.hpp, hourglass_stiffness): the map of the reference pairs
+        // that fits their current offsets best, then forces against the rest.
+        const Vec<D> x0_i = load(reference, i);
         HourglassFit<D> fit;
         count = 0;
+        QuadraticSums<D>* quadratic_sums = General && stiff_quadratic ? &QuadraticSums<D>::of_this_thread() : nullptr;
+        if (quadratic_sums) quadratic_sums->start(row.size());
         for (NodeIndex j : row) {
-            if (!stiff_pair(j)) continue;
-            const Vec<D> initial = load(f.initial_position, j) - x0_i;
-            const double w = hourglass_pair_weight(1.0, initial.squaredNorm());
-            accumulate_hourglass_fit<D>(initial, load(f.position, j) - x_i, w, fit);
+            Vec<D> initial;
+            double w = 0.0;
+            if (!stiffness_pair(j, x0_i, initial, w)) continue;
+            if (quadratic_sums) {
+                quadratic_sums->add(initial, load(f.position, j) - x_i, w, stiff_inverse_h);
+            } else {
+                accumulate_hourglass_fit<D>(initial, load(f.position, j) - x_i, w, fit);
+            }
             pairs[count++] = {j, initial, w};
         }
-        Mat<D> inverse;
         no_kept_fit(f.stiffness_fit);
-        if (invert(fit, inverse)) {
-            const Mat<D> fitted_map = fit.difference * inverse;
-            const double k = hourglass_stiffness(f.stiffness, f.mass[i], f.sound_speed[i], f.initial_diameter[i]) / fit.weight;
-            keep(f.stiffness_fit, k, fitted_map);
-            for (std::size_t e = 0; e < count; ++e) {
-                const Pair& p = pairs[e];
-                const Vec<D> force_on_j = (-k * p.weight) *
-                                          hourglass_displacement_error<D>(fitted_map, p.offset, load(f.position, p.j) - x_i);
-                if (scatter) {
-                    for (int c = 0; c < D; ++c) f.force[c][p.j] += force_on_j[c];
+        const CentreFit<D> fitted = quadratic_sums ? quadratic_centre_fit<D>(quadratic_sums->sums(), stiff_inverse_h, invert)
+                                                   : affine_centre_fit<D>(fit, invert);
+        if (fitted.found) {
+            const double k = hourglass_stiffness(f.stiffness, f.mass[i], f.sound_speed[i], f.initial_diameter[i]) / fitted.weight;
+            keep(f.stiffness_fit, k, fitted.map);
+            keep_curvature(f.stiffness_fit, fitted);
+            with_fit_kind<General>(fitted, [&](auto curved) {
+                for (std::size_t e = 0; e < count; ++e) {
+                    const Pair& p = pairs[e];
+                    const Vec<D> force_on_j =
+                        (-k * p.weight) * fitted.template error<decltype(curved)::value>(p.offset, load(f.position, p.j) - x_i);
+                    if (scatter) {
+                        for (int c = 0; c < D; ++c) f.force[c][p.j] += force_on_j[c];
+                    }
+                    on_centre -= force_on_j;
+                    out.stiffness += power_of(p.j, force_on_j, load(f.velocity, p.j) - v_i);
                 }
-                on_centre -= force_on_j;
-                out.stiffness += power_of(p.j, force_on_j, load(f.velocity, p.j) - v_i);
-            }
+            });
         }
     }
     if (scatter) {
@@ -202,21 +414,48 @@ HourglassPower hourglass_centre(std::span<const NodeIndex> row, std::size_t i, c
     return out;
 }
 
+// The control's general form is needed: the quadratic fit, or a relaxing reference.
 template <int D>
-void apply_hourglass_control(const CompressedRows& lists, const ScatterPlan& plan, const HourglassFields<D>& f,
-                             std::size_t real_count, double coefficient) {
+bool general_control(const HourglassFields<D>& f) {
+    return f.quadratic || f.reference_position[0] != nullptr;
+}
+
+template <int D, bool General>
+void control_all(const CompressedRows& lists, const ScatterPlan& plan, const HourglassFields<D>& f, std::size_t real_count,
+                 double coefficient) {
     const bool with_stiffness = f.stiffness > 0.0;
     for (std::size_t colour = 0; colour < plan.colours(); ++colour) {
         tbb::parallel_for(tbb::blocked_range<std::size_t>(plan.colour_offsets[colour], plan.colour_offsets[colour + 1], 1),
                           [&](const tbb::blocked_range<std::size_t>& groups) {
                               for (std::size_t g = groups.begin(); g != groups.end(); ++g) {
                                   for (NodeIndex i : plan.group(g)) {
-                                      const HourglassPower p = hourglass_centre<D>(lists.row(i), i, f, real_count, coefficient);
+                                      const HourglassPower p =
+                                          centre_control<D, General>(lists.row(i), i, f, real_count, coefficient);
                                       f.power[i] = p.damping;
                                       if (with_stiffness) f.stiffness_power[i] = p.stiffness;
                                   }
                               }
                           });
+    }
+}
+
+}  // namespace
+
+template <int D>
+HourglassPower hourglass_centre(std::span<const NodeIndex> row, std::size_t i, const HourglassFields<D>& f,
+                                std::size_t real_count, double coefficient) {
+    return general_control(f) ? centre_control<D, true>(row, i, f, real_count, coefficient)
+                              : centre_control<D, false>(row, i, f, real_count, coefficient);
+}
+
+template <int D>
+void apply_hourglass_control(const CompressedRows& lists, const ScatterPlan& plan, const HourglassFields<D>& f,
+                             std::size_t real_count, double coefficient) {
+    // The form chosen once for the pass (centre_control).
+    if (general_control(f)) {
+        control_all<D, true>(lists, plan, f, real_count, coefficient);
+    } else {
+        control_all<D, false>(lists, plan, f, real_count, coefficient);
     }
 }
 

@@ -237,6 +237,9 @@ void GhostSet::update(NodeStore& nodes, std::size_t real_count) const {
         mirror_to_ghosts(vector_field(nodes.position), dim, real_count, r.begin(), r.end(), Mirrored::Point);
         mirror_to_ghosts(vector_field(nodes.velocity), dim, real_count, r.begin(), r.end(), Mirrored::Vector);
         mirror_to_ghosts(vector_field(nodes.initial_position), dim, real_count, r.begin(), r.end(), Mirrored::Point);
+        if (nodes.carries_reference_positions()) {
+            mirror_to_ghosts(vector_field(nodes.reference_position), dim, real_count, r.begin(), r.end(), Mirrored::Point);
+        }
         const NodeIndex* source = source_.data();
         copy_to_ghosts(nodes.mass.data(), source, real_count, r.begin(), r.end());
         copy_to_ghosts(nodes.volume.data(), source, real_count, r.begin(), r.end());

@@ -34,6 +34,7 @@ void NodeStore::for_each_field(F&& f) {
     for (int c = 0; c < d; ++c) {
         f("position", position[c]);
         f("initial_position", initial_position[c]);
+        if (carries_reference_) f("reference_position", reference_position[c]);
         f("velocity", velocity[c]);
         f("alpha", alpha[c]);
         f("force", force[c]);
@@ -126,6 +127,15 @@ void NodeStore::resize(std::size_t count) {
     for_each_field([count](std::string_view, auto& field) { resize_with_slack(field, count); });
     resize_rows(fixed_neighbours, nullptr, count);
     resize_rows(fixed_mirrors, &fixed_mirror_planes, count);
+}
+
+void NodeStore::carry_reference_positions() {
+    if (carries_reference_) return;
+    carries_reference_ = true;
+    for (int c = 0; c < dim_; ++c) {
+        reference_position[c] = position[c];
+        reference_position[c].reserve(position[c].capacity());
+    }
 }
 
 void NodeStore::permute(std::span<const NodeIndex> new_to_old) {

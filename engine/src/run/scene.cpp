@@ -624,8 +624,8 @@ void check_plane(const Scene& scene, const PlaneSpec& p, std::size_t i) {
 }
 
 // Every key's range or word list, from the table of solver options (solver_options.hpp), so that
-// validation, the scene reader and study variants cannot disagree; then the one rule that involves
-// several keys (the stress-difference form's), written by hand.
+// validation, the scene reader and study variants cannot disagree; then the rules that involve
+// several keys (the stress-difference form's, the relaxing stiffness's), written by hand.
 void check_solver(const SolverOptions& s) {
     for (const SolverOption& option : solver_option_table()) {
         if (auto message = option_error(option, s)) fail(std::move(*message));
@@ -636,6 +636,12 @@ void check_solver(const SolverOptions& s) {
             fail("solver.force_form = \"stress-difference\" takes viscosity = \"nodal\" or \"none\": bond viscosity is a "
                  "pair force");
         }
+    }
+    // A time constant without a stiffness to relax would be ignored without a word.
+    if (s.hourglass_stiffness_relaxation > 0.0 && !(s.hourglass_stiffness > 0.0)) {
+        fail(fmt::format("solver.hourglass_stiffness_relaxation = {:g} s needs solver.hourglass_stiffness > 0 (the stiffness "
+                         "whose reference relaxes); it is 0",
+                         s.hourglass_stiffness_relaxation));
     }
 }
 

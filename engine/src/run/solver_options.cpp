@@ -90,8 +90,12 @@ std::vector<SolverOption> make_table() {
                  "the nodes the hourglass damping acts on: the lattice regime, every node that has not failed, or "
                  "automatic (every node in 3D, the lattice regime in 2D)",
                  ""});
+    t.push_back({"hourglass_fit", choice_of(&S::hourglass_fit, {{"linear", HourglassFitOrder::Linear}, {"quadratic", HourglassFitOrder::Quadratic}}),
+                 "the hourglass control's fit around a centre: affine, or with second derivatives (the damping's, and the relaxing stiffness's)", ""});
     t.push_back({"hourglass_stiffness", number(&S::hourglass_stiffness, closed(0.0, 1.0)),
                  "C_hs, stiffness against the non-affine displacement of fixed nodes' lattice pairs", "0 = off"});
+    t.push_back({"hourglass_stiffness_relaxation", duration(&S::hourglass_stiffness_relaxation, closed_open(0.0, inf)),
+                 "time constant of the relaxing reference of the stiffness form on flowing nodes", "0 = fixed nodes only"});
     t.push_back({"smoothing",
                  choice_of(&S::smoothing, {{"off", SmoothingMode::Off},
                                            {"everywhere", SmoothingMode::Everywhere},

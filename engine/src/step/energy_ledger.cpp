@@ -25,7 +25,8 @@ EnergyLedger::EnergyLedger(const SolverOptions& solver)
       bond_(solver.viscosity == ViscosityKind::Bond),
       hourglass_(solver.hourglass_coefficient > 0.0 || solver.hourglass_stiffness > 0.0),
       stiffness_(solver.hourglass_stiffness > 0.0),
-      damping_(solver.hourglass_coefficient > 0.0) {}
+      damping_(solver.hourglass_coefficient > 0.0),
+      quadratic_(solver.hourglass_fit == HourglassFitOrder::Quadratic) {}
 
 double* EnergyLedger::bond_power(std::size_t count) { return zeroed(bond_power_, count); }
 double* EnergyLedger::hourglass_power(std::size_t count) { return zeroed(hourglass_power_, count); }
@@ -41,6 +42,15 @@ void EnergyLedger::keep_hourglass_fits(HourglassFields<D>& control, std::size_t 
         for (int k = 0; k < D * D; ++k) kept.matrix[k] = store[k + 1].data();
     };
     if (damping_) point(damping_fit_, control.damping_fit);
+    // The quadratic fits' Cfit (hourglass.hpp, KeptFit::curvature).
+    const auto point_curvature = [count](std::array<std::vector<double>, 18>& store, typename HourglassFields<D>::KeptFit& kept) {
+        for (int k = 0; k < D * curvature_terms<D>; ++k) {
+            store[k].resize(count);
+            kept.curvature[k] = store[k].data();
+        }
+    };
+    if (damping_ && quadratic_) point_curvature(damping_curvature_, control.damping_fit);
+    if (stiffness_ && quadratic_) point_curvature(stiffness_curvature_, control.stiffness_fit);
     if (stiffness_) point(stiffness_fit_, control.stiffness_fit);
 }
 
@@ -163,6 +173,8 @@ void EnergyLedger::memory_use(MemoryUse& out) const {
     std::size_t fits = 0;
     for (const auto& v : damping_fit_) fits += allocated_bytes(v);
     for (const auto& v : stiffness_fit_) fits += allocated_bytes(v);
+    for (const auto& v : damping_curvature_) fits += allocated_bytes(v);
+    for (const auto& v : stiffness_curvature_) fits += allocated_bytes(v);
     add_memory(out, "energy ledger: hourglass fits of the force pass", fits);
 }
 

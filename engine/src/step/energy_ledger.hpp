@@ -84,6 +84,7 @@ private:
     bool hourglass_ = false;
     bool stiffness_ = false;
     bool damping_ = false;  // the hourglass control's damping form (C_hg > 0)
+    bool quadratic_ = false;  // its quadratic fit (SolverOptions::hourglass_fit)
     bool stress_powers_due_ = false;  // compatible_powers ran this step: book the stress work
     double boundary_work_ = 0.0;
     double hourglass_work_ = 0.0;
@@ -94,6 +95,8 @@ private:
     std::array<std::vector<double>, 3> half_velocity_;                    // per node, ghosts included
     // The force pass's hourglass fits per real node: the scale, then the D * D matrix entries.
     std::array<std::vector<double>, 10> damping_fit_, stiffness_fit_;
+    // The quadratic fits' Cfit per real node, D * D (D + 1) / 2 entries (SolverOptions::hourglass_fit).
+    std::array<std::vector<double>, 18> damping_curvature_, stiffness_curvature_;
 };
 
 }  // namespace gpa

@@ -161,6 +161,7 @@ void Simulation::Impl::setup() {
     }
     real = nodes.size();
     particles = real > 0;
+    if (relaxing_stiffness(scene.solver)) nodes.carry_reference_positions();
     if (std::any_of(scene.bodies.begin(), scene.bodies.end(),
                     [](const BodySpec& b) { return b.discretisation == Discretisation::Elements; })) {
         elements = std::make_unique<ElementPart>(scene, mesh_element_bodies(scene), element_options(scene));
@@ -235,6 +236,19 @@ void Simulation::Impl::move() {
             for (std::size_t i = r.begin(); i != r.end(); ++i) x[i] = leapfrog_position(x[i], v[i], dt);
         }
     });
+    if (relaxing_stiffness(scene.solver)) {
+        const double tau = scene.solver.hourglass_stiffness_relaxation;
+        // The stiffness form's reference relaxes towards the new positions, X_r += (x - X_r)(1 - e^(-dt / tau)),
+        // one rate for every node so that an affine motion leaves the reference's offsets an affine image.
+        const double share = -std::expm1(-dt / tau);
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, real, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
+            for (int c = 0; c < d; ++c) {
+                const double* x = nodes.position[c].data();
+                double* ref = nodes.reference_position[c].data();
+                for (std::size_t i = r.begin(); i != r.end(); ++i) ref[i] += (x[i] - ref[i]) * share;
+            }
+        });
+    }
     regions.advance_displacements(dim(), dt);
     time += dt;
     rigid_planes.guard_penetration(ghosts, nodes, real, ledger);  // spec section 7
@@ -406,6 +420,10 @@ HourglassFields<G::dim> Simulation::Impl::hourglass_control_fields(double* power
     const double lattice_plastic_strain =
         every_node ? std::numeric_limits<double>::infinity() : scene.solver.switch_plastic_strain;
     auto h = hourglass_fields<G::dim>(nodes, lattice_plastic_strain, power, scene.solver.hourglass_stiffness, stiffness_power);
+    h.quadratic = scene.solver.hourglass_fit == HourglassFitOrder::Quadratic;
+    if (relaxing_stiffness(scene.solver)) {
+        for (int c = 0; c < G::dim; ++c) h.reference_position[c] = nodes.reference_position[c].data();
+    }
     if (every_node || (contact.sliding() && contact.failed_pairs_separate())) h.failed = nodes.failed.data();
     h.ghost_continues = ghosts.continuing_flags();
     return h;

@@ -9,6 +9,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <span>
+#include <type_traits>
 
 #include "gpa/engine/colouring.hpp"
 #include "gpa/engine/compressed_rows.hpp"
@@ -41,12 +42,20 @@ struct HourglassFields {
     // Variable-connectivity centres are controlled while their equivalent plastic strain is below
     // this (the lattice regime, where the mode lives: see apply_hourglass_control); fixed ones always.
     double lattice_plastic_strain = 0.0;
+    // The fit with the second derivatives (SolverOptions::hourglass_fit; kernels.hpp,
+    // QuadraticHourglassFit) for the damping and for the stiffness form on flowing centres; the
+    // affine fit otherwise (and always for fixed centres' stiffness, against the lattice).
+    bool quadratic = false;
     // The stiffness form (kernels.hpp, hourglass_stiffness): C_hs > 0 adds, on fixed centres, forces
     // against the non-affine part of the lattice pairs' displacement since t = 0 (pairs of two fixed
     // nodes of one body), from the initial positions and diameters.
     double stiffness = 0.0;  // C_hs; 0 = none
     std::array<const double*, D> initial_position{};
     const double* initial_diameter = nullptr;
+    // Set with SolverOptions::hourglass_stiffness_relaxation: the stiffness form acts on the
+    // controlled variable centres too, against the relaxing reference (NodeStore::reference_position)
+    // over all their controlled pairs, weighed as the damping weighs them.
+    std::array<const double*, D> reference_position{};
     // outputs
     std::array<double*, D> force{};  // added to; all null: only the power is computed
     double* power = nullptr;         // per centre: the power of its damping forces (<= 0), W
@@ -63,6 +72,9 @@ struct HourglassFields {
     struct KeptFit {
         double* scale = nullptr;
         std::array<double*, D * D> matrix{};
+        // The quadratic fit's Cfit (D * curvature_terms entries, row-major; zero where the affine fit
+        // served): set with `quadratic` (for the stiffness form, read on flowing centres only).
+        std::array<double*, D * curvature_terms<D>> curvature{};
     };
     KeptFit damping_fit, stiffness_fit;  // written when set and use_kept_fits is false
     bool use_kept_fits = false;          // read the kept fits instead of fitting (no forces are added then)
@@ -114,8 +126,11 @@ inline bool controlled_hourglass_pair(const HourglassFields<D>& f, std::size_t i
 // (use_kept_fits), pair by pair (term), for a pass that walks the row for sums of its own (the energy
 // booking's, compute_stress_power): F_j = -kappa w_j e_ij (kernels.hpp), its power
 // F_j . (w_j - w_i) at power_velocity. The same numbers, in the same order, as hourglass_centre's
-// own walk of the row, which uses it too.
-template <int D>
+// own walk of the row, which uses it too. `Curved`: the fit may have second derivatives
+// (HourglassFields::quadratic; kept zero where the affine fit served); the pass chooses it once, so
+// that the affine walk carries neither the curvature's registers nor a branch per pair (both slowed
+// the booking pass by a fifth to a half when they were there at run time).
+template <int D, bool Curved = false>
 class KeptDampingPower {
 public:
     KeptDampingPower() = default;
@@ -127,6 +142,14 @@ public:
         if (kappa_ == 0.0) return;
         for (int a = 0; a < D; ++a) {
             for (int b = 0; b < D; ++b) fitted_gradient_(a, b) = f.damping_fit.matrix[a * D + b][i];
+        }
+        if constexpr (Curved) {
+            curved_.inverse_h = 1.0 / f.smallest_h[i];
+            for (int a = 0; a < D; ++a) {
+                for (int b = 0; b < curvature_terms<D>; ++b) {
+                    curved_.curvature(a, b) = f.damping_fit.curvature[a * curvature_terms<D> + b][i];
+                }
+            }
         }
         other_velocity_ = f.power_velocity[0] != nullptr;
         for (int c = 0; c < D; ++c) {
@@ -147,7 +170,11 @@ public:
         // fused walk took twice the time of the two walks it replaced).
         const double w = hourglass_pair_weight(f.size_weight[j], r.squaredNorm());
         const double scale = -kappa_ * w;
-        const Vec<D> fitted = fitted_gradient_ * r;
+        Vec<D> fitted = fitted_gradient_ * r;
+        if constexpr (Curved) {
+            // As quadratic_fitted_velocity sums them; a zero Cfit (the affine fit served) adds +0.
+            fitted += curved_.curvature * curvature_basis<D>(r, curved_.inverse_h);
+        }
         double power = 0.0;
         for (int a = 0; a < D; ++a) {
             const double dv = f.velocity[a][j] - v_i_[a];
@@ -159,11 +186,17 @@ public:
     }
 
 private:
+    struct CurvedPart {
+        double inverse_h = 0.0;
+        Eigen::Matrix<double, D, curvature_terms<D>> curvature = Eigen::Matrix<double, D, curvature_terms<D>>::Zero();
+    };
+    struct NoCurvature {};
     std::size_t i_ = 0;
     double kappa_ = 0.0;
     bool other_velocity_ = false;
     Mat<D> fitted_gradient_ = Mat<D>::Zero();
     Vec<D> v_i_ = Vec<D>::Zero(), w_i_ = Vec<D>::Zero();
+    [[no_unique_address]] std::conditional_t<Curved, CurvedPart, NoCurvature> curved_;
 };
 
 template <int D>

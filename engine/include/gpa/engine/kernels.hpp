@@ -350,6 +350,59 @@ inline void accumulate_hourglass_fit(const Vec<D>& r, const Vec<D>& dv, double w
     fit.weight += w;
 }
 
+// The quadratic fit of the damping (SolverOptions::hourglass_fit = quadratic; spec section 2,
+// "[spec] Hourglass control"): the velocity around the centre fitted with its second derivatives
+// too,
+//   dv_j ~ Lfit_i r_j + Cfit_i q(r_j),   q(r) = (r_a r_b / h_i, a <= b),
+// (D (D + 1) / 2 terms, divided by h_i so that they have the units of r), by the same weighted
+// least squares over the same pairs. e_ij = dv_j - Lfit r_j - Cfit q(r_j) is then zero for every
+// velocity field with constant second derivatives over the support: a flow that bends smoothly
+// (a Taylor bar's mushrooming head) is left alone where the affine fit damps it, while an
+// odd-even or pairing pattern, which no quadratic follows, is not. The normal equations give
+// sum_j w_j e_ij r_j^T = 0 and sum_j w_j e_ij q_j^T = 0, so the forces F_j = -kappa w_j e_ij /
+// sum_k w_k conserve linear and angular momentum and only dissipate, as for the affine fit.
+template <int D>
+inline constexpr int curvature_terms = D * (D + 1) / 2;
+
+template <int D>
+using CurvatureVec = Eigen::Matrix<double, curvature_terms<D>, 1>;
+
+template <int D>
+inline CurvatureVec<D> curvature_basis(const Vec<D>& r, double inverse_h) {
+    CurvatureVec<D> q;
+    int k = 0;
+    for (int a = 0; a < D; ++a) {
+        for (int b = a; b < D; ++b) q[k++] = r[a] * r[b] * inverse_h;
+    }
+    return q;
+}
+
+// The fitted velocity difference Lfit r + Cfit q(r) of a pair: the force pass and the energy
+// booking's walk (KeptDampingPower) both make it with this, so that both get the same bits.
+template <int D>
+inline Vec<D> quadratic_fitted_velocity(const Mat<D>& gradient, const Eigen::Matrix<double, D, curvature_terms<D>>& curvature,
+                                        const Vec<D>& r, double inverse_h) {
+    return gradient * r + curvature * curvature_basis<D>(r, inverse_h);
+}
+
+// The quadratic fit's normal equations over the pairs: the moment of phi = (r, q(r)) and
+// sum_j w_j dv_j phi_j^T (hourglass.cpp sums them, QuadraticSums).
+template <int D>
+struct QuadraticHourglassFit {
+    static constexpr int terms = D + curvature_terms<D>;
+    Eigen::Matrix<double, terms, terms> moment = Eigen::Matrix<double, terms, terms>::Zero();
+    Eigen::Matrix<double, D, terms> difference = Eigen::Matrix<double, D, terms>::Zero();
+    double weight = 0.0;
+    // The affine fit's sums, which are part of these (where the second derivatives are not fixed).
+    HourglassFit<D> affine_part() const {
+        HourglassFit<D> fit;
+        fit.moment = moment.template topLeftCorner<D, D>();
+        fit.difference = difference.template leftCols<D>();
+        fit.weight = weight;
+        return fit;
+    }
+};
+
 // The weight of a lattice pair in the fit and the force: w = W_j / r^2.
 inline double hourglass_pair_weight(double size_weight_j, double r_squared) { return size_weight_j / r_squared; }
 
@@ -360,7 +413,8 @@ inline double hourglass_damping(double coefficient, double mass, double sound_sp
 }
 
 // e_ij = (v_j - v_i) - Lfit_i r_j: the part of a lattice pair's velocity difference that no
-// affine field around the centre explains.
+// affine field around the centre explains; for the stiffness form below, with dX for r and dx for
+// dv, e_ij = dx_j - Ffit_i dX_j.
 template <int D>
 inline Vec<D> hourglass_velocity_error(const Mat<D>& fitted_gradient, const Vec<D>& r, const Vec<D>& dv) {
     return dv - fitted_gradient * r;
@@ -381,15 +435,15 @@ inline Vec<D> hourglass_velocity_error(const Mat<D>& fitted_gradient, const Vec<
 // against the mode's negative stiffness of about 4 sigma / (rho d0^2): C_hs = 0.05 holds it up to a
 // tensile stress of about 1 % of rho c^2 (3 GPa in steel). The fit reuses accumulate_hourglass_fit
 // with r = dX, dv = dx.
+// On flowing (variable) centres (SolverOptions::hourglass_stiffness_relaxation) X is a reference
+// that relaxes towards the positions, X_r += (x - X_r)(1 - e^(-dt / tau)) each step, one rate for
+// every node (an affine motion then leaves the reference an affine image of the positions, which
+// the fit follows), over the centre's controlled pairs with the damping's weights w_j = W_j / r^2;
+// with the quadratic fit the map takes the reference's second derivatives too. Flow older than tau
+// is forgotten; a pattern that grows faster than 1 / tau meets a spring (the forces are no longer a
+// potential's gradient, and their work is booked as the centre's internal energy all the same).
 inline double hourglass_stiffness(double coefficient, double mass, double sound_speed, double initial_diameter) {
     return coefficient * mass * sound_speed * sound_speed / (initial_diameter * initial_diameter);
-}
-
-// e_ij = dx_j - Ffit_i dX_j: the part of a lattice pair's displacement that no affine map of the
-// initial lattice around the centre explains.
-template <int D>
-inline Vec<D> hourglass_displacement_error(const Mat<D>& fitted_map, const Vec<D>& initial_offset, const Vec<D>& offset) {
-    return offset - fitted_map * initial_offset;
 }
 
 // The volume ratio of a lattice cell of a fixed-connectivity node (spec section 2, "[spec] Lattice

@@ -46,12 +46,23 @@ public:
     // The bytes each field takes (memory_use.hpp), as "nodes: FIELD".
     void memory_use(MemoryUse& out) const;
 
+    // From now on reference_position is one of the fields (resized, reordered, checkpointed and
+    // reported with them), starting at the current positions. A scene without the relaxing
+    // stiffness never calls it and carries nothing.
+    void carry_reference_positions();
+    bool carries_reference_positions() const { return carries_reference_; }
+
     // --- state carried from step to step -------------------------------------------------
     std::array<std::vector<double>, 3> position;   // m
     // Position on the initial lattice, m: x0 of Eq. 3, and the lattice distances r0 that weigh
     // fixed-connectivity pairs (spec section 2).
     std::array<std::vector<double>, 3> initial_position;
     std::array<std::vector<double>, 3> velocity;   // m/s
+    // The relaxing reference of the hourglass stiffness on flowing nodes (SolverOptions::
+    // hourglass_stiffness_relaxation), m: the position when carry_reference_positions() was
+    // called, drawn towards the position with the relaxation's time constant. Empty unless
+    // carried.
+    std::array<std::vector<double>, 3> reference_position;
     std::vector<double> mass;                      // kg (a ring's mass in axisymmetric geometry)
     std::vector<double> volume;                    // V, m^3 (unit thickness in plane strain)
     std::vector<double> initial_volume;            // V0
@@ -111,6 +122,7 @@ private:
 
     GeometryKind geometry_;
     int dim_;
+    bool carries_reference_ = false;
 };
 
 // Checks what the method cannot work with, for nodes [first, last): a non-finite or (in

@@ -243,6 +243,7 @@ enum class NodeDiameter {
 
 // Which nodes the hourglass damping (hourglass_coefficient) acts on (docs/validation.md, "The face
 // pairs in the hoop direction").
+enum class HourglassFitOrder { Linear, Quadratic };
 enum class HourglassNodes {
     // Every node in 3D, the lattice regime in 2D (hourglass_damps_every_node): the face's pairing
     // needs a discretised hoop direction, which axisymmetric bodies do not have. The default.
@@ -280,10 +281,17 @@ struct SolverOptions {
     // nodes of hourglass_nodes.
     double hourglass_coefficient = 0.1;
     HourglassNodes hourglass_nodes = HourglassNodes::Automatic;
+    // The damping's fit: the affine velocity field around the centre (linear), or one with its
+    // second derivatives too (quadratic), which leaves smooth curved flow alone.
+    HourglassFitOrder hourglass_fit = HourglassFitOrder::Linear;
     // C_hs of the stiffness form of the control (kernels.hpp, hourglass_stiffness): on fixed nodes,
     // forces against the non-affine part of the lattice pairs' displacement since t = 0, which the
     // damping alone cannot hold under tension (docs/tension.md). 0 = off.
     double hourglass_stiffness = 0.0;
+    // The stiffness form on the flowing nodes the damping controls (hourglass_nodes), against a
+    // reference that relaxes towards the current positions with this time constant, s (kernels.hpp,
+    // hourglass_stiffness). 0: the stiffness acts on fixed nodes only.
+    double hourglass_stiffness_relaxation = 0.0;
     SmoothingMode smoothing = SmoothingMode::Off;
     double smoothing_coefficient = 0.1;  // C_cs (Eq. 67)
     // C_cfl of the stable time step (spec section 11). The largest value found stable: 0.6 (the
@@ -376,6 +384,12 @@ struct Scene {
 
 // Whether the hourglass damping acts on every node (SolverOptions::hourglass_nodes), the automatic
 // choice resolved by the scene's geometry.
+// The stiffness form acts on flowing nodes too, against a relaxing reference
+// (SolverOptions::hourglass_stiffness_relaxation).
+inline bool relaxing_stiffness(const SolverOptions& solver) {
+    return solver.hourglass_stiffness > 0.0 && solver.hourglass_stiffness_relaxation > 0.0;
+}
+
 inline bool hourglass_damps_every_node(const SolverOptions& solver, GeometryKind geometry) {
     if (solver.hourglass_nodes == HourglassNodes::Automatic) return geometry == GeometryKind::ThreeD;
     return solver.hourglass_nodes == HourglassNodes::All;
