@@ -71,11 +71,14 @@ bool solve_quadratic_fit(const QuadraticHourglassFit<D>& fit, Mat<D>& gradient, 
 // The quadratic fit's sums over a row by two matrix products, the pairs' bases phi = (r, q(r)),
 // weighted bases and differences gathered first: summed pair by pair, the 9-by-9 moment of 3D
 // does not fit the registers, and each of its 45 terms became a load and a store per pair. One
-// per thread, reused from centre to centre (no allocation once it holds the longest row).
+// per thread, reused from centre to centre (no allocation once it holds the longest row). A second
+// difference per pair (add_both: the displacement since the relaxing reference) shares the basis,
+// so that the damping's and the relaxed stiffness's fits take one moment and one factor.
 template <int D>
 class QuadraticSums {
 public:
     static constexpr int P = QuadraticHourglassFit<D>::terms;
+    using SecondDifference = Eigen::Matrix<double, D, P>;
     static QuadraticSums& of_this_thread() {
         thread_local QuadraticSums sums;
         return sums;
@@ -84,7 +87,7 @@ public:
         if (static_cast<std::size_t>(basis_.rows()) < pairs) {
             basis_.resize(static_cast<Eigen::Index>(pairs), P);
             weighted_.resize(static_cast<Eigen::Index>(pairs), P);
-            difference_.resize(static_cast<Eigen::Index>(pairs), D);
+            difference_.resize(static_cast<Eigen::Index>(pairs), 2 * D);
         }
         count_ = 0;
         weight_ = 0.0;
@@ -94,20 +97,39 @@ public:
         basis_.row(k).template head<D>() = r.transpose();
         basis_.row(k).template tail<curvature_terms<D>>() = curvature_basis<D>(r, inverse_h).transpose();
         weighted_.row(k) = w * basis_.row(k);
-        difference_.row(k) = difference.transpose();
+        difference_.row(k).template head<D>() = difference.transpose();
         weight_ += w;
     }
+    void add_both(const Vec<D>& r, const Vec<D>& difference, const Vec<D>& second, double w, double inverse_h) {
+        difference_.row(count_).template tail<D>() = second.transpose();
+        add(r, difference, w, inverse_h);
+    }
+    // The products as dot products of the gathered columns, the moment's upper triangle mirrored:
+    // for rows of a few dozen pairs Eigen's general matrix product spent a fifth of the step
+    // packing its operands.
     QuadraticHourglassFit<D> sums() const {
         QuadraticHourglassFit<D> fit;
-        fit.moment.noalias() = basis_.topRows(count_).transpose() * weighted_.topRows(count_);
-        fit.difference.noalias() = difference_.topRows(count_).transpose() * weighted_.topRows(count_);
+        for (int k = 0; k < P; ++k) {
+            const auto weighted = weighted_.col(k).head(count_);
+            for (int l = 0; l <= k; ++l) fit.moment(l, k) = fit.moment(k, l) = basis_.col(l).head(count_).dot(weighted);
+            for (int a = 0; a < D; ++a) fit.difference(a, k) = difference_.col(a).head(count_).dot(weighted);
+        }
         fit.weight = weight_;
         return fit;
+    }
+    // The sums of the second differences (add_both), beside sums().
+    SecondDifference second_sums() const {
+        SecondDifference out;
+        for (int k = 0; k < P; ++k) {
+            const auto weighted = weighted_.col(k).head(count_);
+            for (int a = 0; a < D; ++a) out(a, k) = difference_.col(D + a).head(count_).dot(weighted);
+        }
+        return out;
     }
 
 private:
     Eigen::Matrix<double, Eigen::Dynamic, P> basis_, weighted_;
-    Eigen::Matrix<double, Eigen::Dynamic, D> difference_;
+    Eigen::Matrix<double, Eigen::Dynamic, 2 * D> difference_;
     Eigen::Index count_ = 0;
     double weight_ = 0.0;
 };
@@ -171,6 +193,39 @@ CentreFit<D> quadratic_centre_fit(const QuadraticHourglassFit<D>& sums, double i
     fit.weight = sums.weight;
     fit.found = fit.weight > 0.0;
     return fit;
+}
+
+// Both fits of one basis (QuadraticSums::add_both): the quadratic ones from one factor of the
+// moment where the pairs fix the second derivatives, else the affine ones from its affine part.
+template <int D, class Invert>
+std::array<CentreFit<D>, 2> quadratic_centre_fits(const QuadraticHourglassFit<D>& sums,
+                                                  const typename QuadraticSums<D>::SecondDifference& second, double inverse_h,
+                                                  const Invert& invert) {
+    constexpr int P = QuadraticHourglassFit<D>::terms;
+    QuadraticHourglassFit<D> other = sums;
+    other.difference = second;
+    std::array<CentreFit<D>, 2> fits;
+    const Eigen::LLT<Eigen::Matrix<double, P, P>> factor(sums.moment);
+    const auto pivots = factor.matrixLLT().diagonal().cwiseAbs2();
+    if (factor.info() != Eigen::Success || !(pivots.minCoeff() > 1e-12 * pivots.maxCoeff())) {
+        fits[0] = affine_centre_fit<D>(sums.affine_part(), invert);
+        fits[1] = affine_centre_fit<D>(other.affine_part(), invert);
+        return fits;
+    }
+    Eigen::Matrix<double, P, 2 * D> right;
+    right.template leftCols<D>() = sums.difference.transpose();
+    right.template rightCols<D>() = second.transpose();
+    const Eigen::Matrix<double, P, 2 * D> solution = factor.solve(right);
+    for (int k = 0; k < 2; ++k) {
+        CentreFit<D>& fit = fits[k];
+        fit.map = solution.template block<D, D>(0, k * D).transpose();
+        fit.curvature = solution.template block<curvature_terms<D>, D>(D, k * D).transpose();
+        fit.curved = true;
+        fit.inverse_h = inverse_h;
+        fit.weight = sums.weight;
+        fit.found = fit.weight > 0.0;
+    }
+    return fits;
 }
 
 // One centre of the control (hourglass.hpp, hourglass_centre). `General` false: the affine fit
@@ -258,6 +313,19 @@ HourglassPower centre_control(std::span<const NodeIndex> row, std::size_t i, con
         }
         return m;
     };
+    // The stiffness form: a fixed centre against the initial lattice (its lattice pairs, weights
+    // 1 / |dX|^2, d0); a controlled variable centre, with a relaxing reference, against that
+    // reference over all its controlled pairs (weights W_j / r^2 as the damping's).
+    const bool fixed_centre = f.connectivity[i] == Connectivity::Fixed;
+    const bool relaxed_centre = General && !fixed_centre && f.reference_position[0] != nullptr;
+    const bool stiff_centre = f.stiffness > 0.0 && (fixed_centre || relaxed_centre);
+    // A relaxed centre's displacement since its reference, relative to the centre's:
+    // du_j = (x_j - x_i) - (X_j - X_i) for r = x_j - x_i.
+    const Vec<D> reference_i = relaxed_centre ? load(f.reference_position, i) : Vec<D>::Zero().eval();
+    const auto relaxed_displacement = [&](NodeIndex j, const Vec<D>& r) { return (r - (load(f.reference_position, j) - reference_i)).eval(); };
+    // The relaxed stiffness's fit when the damping's quadratic fit made it from the same moment.
+    CentreFit<D> shared_stiffness_fit;
+    bool stiffness_fit_shared = false;
     if (coefficient > 0.0 && f.use_kept_fits) {
         // The force pass's fit: its forces again, pair by pair as in pass 2 below, for their power.
         const auto kept_power = [&](auto curved) {
@@ -280,14 +348,27 @@ HourglassPower centre_control(std::span<const NodeIndex> row, std::size_t i, con
             const double inverse_h = 1.0 / f.smallest_h[i];
             QuadraticSums<D>& quadratic_sums = QuadraticSums<D>::of_this_thread();
             quadratic_sums.start(row.size());
+            // A relaxed stiff centre's fit has the same pairs, weights and basis (the stiffness
+            // section below): its displacements go into the same sums.
+            stiffness_fit_shared = relaxed_centre && stiff_centre;
             for (NodeIndex j : row) {
                 if (!controlled_pair(j)) continue;
                 const Vec<D> r = load(f.position, j) - x_i;
                 const double w = hourglass_pair_weight(f.size_weight[j], r.squaredNorm());
-                quadratic_sums.add(r, load(f.velocity, j) - v_i, w, inverse_h);
+                if (stiffness_fit_shared) {
+                    quadratic_sums.add_both(r, load(f.velocity, j) - v_i, relaxed_displacement(j, r), w, inverse_h);
+                } else {
+                    quadratic_sums.add(r, load(f.velocity, j) - v_i, w, inverse_h);
+                }
                 pairs[count++] = {j, r, w};
             }
-            fitted = quadratic_centre_fit<D>(quadratic_sums.sums(), inverse_h, invert);
+            if (stiffness_fit_shared) {
+                const auto both = quadratic_centre_fits<D>(quadratic_sums.sums(), quadratic_sums.second_sums(), inverse_h, invert);
+                fitted = both[0];
+                shared_stiffness_fit = both[1];
+            } else {
+                fitted = quadratic_centre_fit<D>(quadratic_sums.sums(), inverse_h, invert);
+            }
         } else {
             HourglassFit<D> fit;
             for (NodeIndex j : row) {
@@ -319,35 +400,34 @@ HourglassPower centre_control(std::span<const NodeIndex> row, std::size_t i, con
             });
         }
     }
-    // The stiffness form: a fixed centre against the initial lattice (its lattice pairs, weights
-    // 1 / |dX|^2, d0); a controlled variable centre, with a relaxing reference, against that
-    // reference over all its controlled pairs (weights W_j / r^2 as the damping's).
-    const bool fixed_centre = f.connectivity[i] == Connectivity::Fixed;
-    const bool relaxed_centre = General && !fixed_centre && f.reference_position[0] != nullptr;
-    const bool stiff_centre = f.stiffness > 0.0 && (fixed_centre || relaxed_centre);
-    const std::array<const double*, D>& reference = relaxed_centre ? f.reference_position : f.initial_position;
-    // The pair's reference offset and weight; false when the pair takes no part.
-    const auto stiffness_pair = [&](NodeIndex j, const Vec<D>& x0_i, Vec<D>& offset, double& w) {
+    // The stiffness's pairs: a fixed centre's offset is its lattice pair's initial one, dX_j =
+    // X0_j - X0_i, fitted to the current offset x_j - x_i (weight 1 / |dX|^2); a relaxed centre's
+    // offset is the current one, r_j, fitted to its displacement since the reference du_j (weight
+    // W_j / r^2, the damping's pairs and basis). False when the pair takes no part.
+    const Vec<D> x0_i = stiff_centre && !relaxed_centre ? load(f.initial_position, i) : Vec<D>::Zero().eval();
+    const auto stiffness_pair = [&](NodeIndex j, Vec<D>& offset, double& w) {
         if (!relaxed_centre) {
             if (!stiff_pair(j)) return false;
-            offset = load(reference, j) - x0_i;
+            offset = load(f.initial_position, j) - x0_i;
             w = hourglass_pair_weight(1.0, offset.squaredNorm());
             return true;
         }
         if (!controlled_pair(j)) return false;
-        offset = load(reference, j) - x0_i;
-        w = hourglass_pair_weight(f.size_weight[j], (load(f.position, j) - x_i).squaredNorm());
+        offset = load(f.position, j) - x_i;
+        w = hourglass_pair_weight(f.size_weight[j], offset.squaredNorm());
         return true;
     };
-    // A relaxed centre with the quadratic fit: its map takes the reference's second derivatives too
-    // (kernels.hpp, QuadraticHourglassFit, with r = dX and dv = dx), so that a smoothly bending
-    // flow since the reference stores nothing.
+    const auto stiffness_difference = [&](NodeIndex j, const Vec<D>& offset) {
+        return relaxed_centre ? relaxed_displacement(j, offset) : (load(f.position, j) - x_i).eval();
+    };
+    // A relaxed centre with the quadratic fit: its fit takes the displacement's second derivatives
+    // too (kernels.hpp, QuadraticHourglassFit, with dv = du), so that a smoothly bending flow since
+    // the reference stores nothing.
     const bool stiff_quadratic = stiff_centre && relaxed_centre && f.quadratic;
     const double stiff_inverse_h = stiff_quadratic ? 1.0 / f.smallest_h[i] : 0.0;
     if (stiff_centre && f.use_kept_fits) {
         const double k = f.stiffness_fit.scale[i];
         if (k != 0.0) {
-            const Vec<D> x0_i = load(reference, i);
             // The force pass's fit again (an affine one that served has a zero Cfit).
             CentreFit<D> kept;
             kept.map = kept_matrix(f.stiffness_fit);
@@ -360,36 +440,42 @@ HourglassPower centre_control(std::span<const NodeIndex> row, std::size_t i, con
             }
             with_fit_kind<General>(kept, [&](auto curved) {
                 for (NodeIndex j : row) {
-                    Vec<D> initial;
+                    Vec<D> offset;
                     double w = 0.0;
-                    if (!stiffness_pair(j, x0_i, initial, w)) continue;
-                    const Vec<D> force_on_j = (-k * w) * kept.template error<decltype(curved)::value>(initial, load(f.position, j) - x_i);
+                    if (!stiffness_pair(j, offset, w)) continue;
+                    const Vec<D> force_on_j =
+                        (-k * w) * kept.template error<decltype(curved)::value>(offset, stiffness_difference(j, offset));
                     out.stiffness += power_of(j, force_on_j, load(f.velocity, j) - v_i);
                 }
             });
         }
     } else if (stiff_centre) {
-        // The stiffness form (kernels.hpp, hourglass_stiffness): the map of the reference pairs
-        // that fits their current offsets best, then forces against the rest.
-        const Vec<D> x0_i = load(reference, i);
-        HourglassFit<D> fit;
-        count = 0;
-        QuadraticSums<D>* quadratic_sums = General && stiff_quadratic ? &QuadraticSums<D>::of_this_thread() : nullptr;
-        if (quadratic_sums) quadratic_sums->start(row.size());
-        for (NodeIndex j : row) {
-            Vec<D> initial;
-            double w = 0.0;
-            if (!stiffness_pair(j, x0_i, initial, w)) continue;
-            if (quadratic_sums) {
-                quadratic_sums->add(initial, load(f.position, j) - x_i, w, stiff_inverse_h);
-            } else {
-                accumulate_hourglass_fit<D>(initial, load(f.position, j) - x_i, w, fit);
+        // The stiffness form (kernels.hpp, hourglass_stiffness): the map that fits the pairs'
+        // differences best, then forces against the rest; from the damping's sums where those
+        // took the displacements too (the pairs of the buffer are the same then).
+        CentreFit<D> fitted;
+        if (stiffness_fit_shared) {
+            fitted = shared_stiffness_fit;
+        } else {
+            HourglassFit<D> fit;
+            count = 0;
+            QuadraticSums<D>* quadratic_sums = General && stiff_quadratic ? &QuadraticSums<D>::of_this_thread() : nullptr;
+            if (quadratic_sums) quadratic_sums->start(row.size());
+            for (NodeIndex j : row) {
+                Vec<D> offset;
+                double w = 0.0;
+                if (!stiffness_pair(j, offset, w)) continue;
+                if (quadratic_sums) {
+                    quadratic_sums->add(offset, stiffness_difference(j, offset), w, stiff_inverse_h);
+                } else {
+                    accumulate_hourglass_fit<D>(offset, stiffness_difference(j, offset), w, fit);
+                }
+                pairs[count++] = {j, offset, w};
             }
-            pairs[count++] = {j, initial, w};
+            fitted = quadratic_sums ? quadratic_centre_fit<D>(quadratic_sums->sums(), stiff_inverse_h, invert)
+                                    : affine_centre_fit<D>(fit, invert);
         }
         no_kept_fit(f.stiffness_fit);
-        const CentreFit<D> fitted = quadratic_sums ? quadratic_centre_fit<D>(quadratic_sums->sums(), stiff_inverse_h, invert)
-                                                   : affine_centre_fit<D>(fit, invert);
         if (fitted.found) {
             const double k = hourglass_stiffness(f.stiffness, f.mass[i], f.sound_speed[i], f.initial_diameter[i]) / fitted.weight;
             keep(f.stiffness_fit, k, fitted.map);
@@ -398,7 +484,7 @@ HourglassPower centre_control(std::span<const NodeIndex> row, std::size_t i, con
                 for (std::size_t e = 0; e < count; ++e) {
                     const Pair& p = pairs[e];
                     const Vec<D> force_on_j =
-                        (-k * p.weight) * fitted.template error<decltype(curved)::value>(p.offset, load(f.position, p.j) - x_i);
+                        (-k * p.weight) * fitted.template error<decltype(curved)::value>(p.offset, stiffness_difference(p.j, p.offset));
                     if (scatter) {
                         for (int c = 0; c < D; ++c) f.force[c][p.j] += force_on_j[c];
                     }

@@ -413,8 +413,8 @@ inline double hourglass_damping(double coefficient, double mass, double sound_sp
 }
 
 // e_ij = (v_j - v_i) - Lfit_i r_j: the part of a lattice pair's velocity difference that no
-// affine field around the centre explains; for the stiffness form below, with dX for r and dx for
-// dv, e_ij = dx_j - Ffit_i dX_j.
+// affine field around the centre explains; for the stiffness form below on fixed centres, with dX
+// for r and dx for dv, e_ij = dx_j - Ffit_i dX_j (on relaxed ones, du for dv).
 template <int D>
 inline Vec<D> hourglass_velocity_error(const Mat<D>& fitted_gradient, const Vec<D>& r, const Vec<D>& dv) {
     return dv - fitted_gradient * r;
@@ -435,13 +435,16 @@ inline Vec<D> hourglass_velocity_error(const Mat<D>& fitted_gradient, const Vec<
 // against the mode's negative stiffness of about 4 sigma / (rho d0^2): C_hs = 0.05 holds it up to a
 // tensile stress of about 1 % of rho c^2 (3 GPa in steel). The fit reuses accumulate_hourglass_fit
 // with r = dX, dv = dx.
-// On flowing (variable) centres (SolverOptions::hourglass_stiffness_relaxation) X is a reference
-// that relaxes towards the positions, X_r += (x - X_r)(1 - e^(-dt / tau)) each step, one rate for
-// every node (an affine motion then leaves the reference an affine image of the positions, which
-// the fit follows), over the centre's controlled pairs with the damping's weights w_j = W_j / r^2;
-// with the quadratic fit the map takes the reference's second derivatives too. Flow older than tau
-// is forgotten; a pattern that grows faster than 1 / tau meets a spring (the forces are no longer a
-// potential's gradient, and their work is booked as the centre's internal energy all the same).
+// On flowing (variable) centres (SolverOptions::hourglass_stiffness_relaxation) the reference is
+// X_r, which relaxes towards the positions, X_r += (x - X_r)(1 - e^(-dt / tau)) each step, one
+// rate for every node (an affine motion then leaves the reference an affine image of the
+// positions). There the fit is the damping's, over the same pairs, weights w_j = W_j / r^2 and
+// basis (the current offsets r_j, with q(r_j) for the quadratic fit), applied to the displacements
+// since the reference, du_j = r_j - (X_r,j - X_r,i), in place of dv_j: e_ij = du_j - Ufit r_j
+// (- Cfit q(r_j)), so that one moment serves both and any displacement field that is affine
+// (quadratic) in the current positions stores nothing. Flow older than tau is forgotten; a
+// pattern that grows faster than 1 / tau meets a spring (the forces are no longer a potential's
+// gradient, and their work is booked as the centre's internal energy all the same).
 inline double hourglass_stiffness(double coefficient, double mass, double sound_speed, double initial_diameter) {
     return coefficient * mass * sound_speed * sound_speed / (initial_diameter * initial_diameter);
 }
