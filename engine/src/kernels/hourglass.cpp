@@ -326,6 +326,7 @@ HourglassPower centre_control(std::span<const NodeIndex> row, std::size_t i, con
     // The relaxed stiffness's fit when the damping's quadratic fit made it from the same moment.
     CentreFit<D> shared_stiffness_fit;
     bool stiffness_fit_shared = false;
+    bool stiffness_done = false;  // its forces went with the damping's (pass 2)
     if (coefficient > 0.0 && f.use_kept_fits) {
         // The force pass's fit: its forces again, pair by pair as in pass 2 below, for their power.
         const auto kept_power = [&](auto curved) {
@@ -385,16 +386,38 @@ HourglassPower centre_control(std::span<const NodeIndex> row, std::size_t i, con
             const double kappa = hourglass_damping(coefficient, f.mass[i], f.sound_speed[i], f.smallest_h[i]) / fitted.weight;
             keep(f.damping_fit, kappa, fitted.map);
             keep_curvature(f.damping_fit, fitted);
+            // The relaxed stiffness of the shared fit (its forces -k w_j e_ij of du_j) in the same walk.
+            double stiffness_scale = 0.0;
+            if constexpr (General) {
+                if (stiffness_fit_shared && shared_stiffness_fit.found) {
+                    stiffness_scale = hourglass_stiffness(f.stiffness, f.mass[i], f.sound_speed[i], f.initial_diameter[i]) /
+                                      shared_stiffness_fit.weight;
+                    keep(f.stiffness_fit, stiffness_scale, shared_stiffness_fit.map);
+                    keep_curvature(f.stiffness_fit, shared_stiffness_fit);
+                    stiffness_done = true;
+                }
+            }
             // Pass 2: F_j = - kappa w_j e_ij on the neighbour, the reaction on the centre.
             with_fit_kind<General>(fitted, [&](auto curved) {
+                constexpr bool curved_fit = decltype(curved)::value;
                 for (std::size_t k = 0; k < count; ++k) {
                     const Pair& p = pairs[k];
                     const Vec<D> dv = load(f.velocity, p.j) - v_i;
-                    const Vec<D> force_on_j = (-kappa * p.weight) * fitted.template error<decltype(curved)::value>(p.offset, dv);
-                    if (scatter) {
-                        for (int c = 0; c < D; ++c) f.force[c][p.j] += force_on_j[c];
+                    const Vec<D> force_on_j = (-kappa * p.weight) * fitted.template error<curved_fit>(p.offset, dv);
+                    Vec<D> total = force_on_j;
+                    if constexpr (General) {
+                        if (stiffness_done) {
+                            const Vec<D> stiffness_on_j =
+                                (-stiffness_scale * p.weight) *
+                                shared_stiffness_fit.template error<curved_fit>(p.offset, relaxed_displacement(p.j, p.offset));
+                            out.stiffness += power_of(p.j, stiffness_on_j, dv);
+                            total += stiffness_on_j;
+                        }
                     }
-                    on_centre -= force_on_j;
+                    if (scatter) {
+                        for (int c = 0; c < D; ++c) f.force[c][p.j] += total[c];
+                    }
+                    on_centre -= total;
                     out.damping += power_of(p.j, force_on_j, dv);
                 }
             });
@@ -449,14 +472,14 @@ HourglassPower centre_control(std::span<const NodeIndex> row, std::size_t i, con
                 }
             });
         }
+    } else if (stiff_centre && stiffness_fit_shared) {
+        // Fitted with the damping and its forces added in the damping's walk.
+        if (!stiffness_done) no_kept_fit(f.stiffness_fit);
     } else if (stiff_centre) {
         // The stiffness form (kernels.hpp, hourglass_stiffness): the map that fits the pairs'
-        // differences best, then forces against the rest; from the damping's sums where those
-        // took the displacements too (the pairs of the buffer are the same then).
+        // differences best, then forces against the rest.
         CentreFit<D> fitted;
-        if (stiffness_fit_shared) {
-            fitted = shared_stiffness_fit;
-        } else {
+        {
             HourglassFit<D> fit;
             count = 0;
             QuadraticSums<D>* quadratic_sums = General && stiff_quadratic ? &QuadraticSums<D>::of_this_thread() : nullptr;
