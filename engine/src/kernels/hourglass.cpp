@@ -303,7 +303,9 @@ HourglassPower centre_control(std::span<const NodeIndex> row, std::size_t i, con
     const auto keep_curvature = [&](const typename HourglassFields<D>::KeptFit& kept, const CentreFit<D>& fit) {
         if (!General || !kept.curvature[0]) return;
         for (int a = 0; a < D; ++a) {
-            for (int b = 0; b < curvature_terms<D>; ++b) kept.curvature[a * curvature_terms<D> + b][i] = fit.curved ? fit.curvature(a, b) : 0.0;
+            for (int b = 0; b < curvature_terms<D>; ++b) {
+                kept.curvature[a * curvature_terms<D> + b][i] = fit.curved ? fit.curvature(a, b) : 0.0;
+            }
         }
     };
     const auto kept_matrix = [&](const typename HourglassFields<D>::KeptFit& kept) {
@@ -322,7 +324,9 @@ HourglassPower centre_control(std::span<const NodeIndex> row, std::size_t i, con
     // A relaxed centre's displacement since its reference, relative to the centre's:
     // du_j = (x_j - x_i) - (X_j - X_i) for r = x_j - x_i.
     const Vec<D> reference_i = relaxed_centre ? load(f.reference_position, i) : Vec<D>::Zero().eval();
-    const auto relaxed_displacement = [&](NodeIndex j, const Vec<D>& r) { return (r - (load(f.reference_position, j) - reference_i)).eval(); };
+    const auto relaxed_displacement = [&](NodeIndex j, const Vec<D>& r) {
+        return (r - (load(f.reference_position, j) - reference_i)).eval();
+    };
     // The relaxed stiffness's fit when the damping's quadratic fit made it from the same moment.
     CentreFit<D> shared_stiffness_fit;
     bool stiffness_fit_shared = false;
@@ -364,7 +368,8 @@ HourglassPower centre_control(std::span<const NodeIndex> row, std::size_t i, con
                 pairs[count++] = {j, r, w};
             }
             if (stiffness_fit_shared) {
-                const auto both = quadratic_centre_fits<D>(quadratic_sums.sums(), quadratic_sums.second_sums(), inverse_h, invert);
+                const auto both =
+                    quadratic_centre_fits<D>(quadratic_sums.sums(), quadratic_sums.second_sums(), inverse_h, invert);
                 fitted = both[0];
                 shared_stiffness_fit = both[1];
             } else {
@@ -458,7 +463,9 @@ HourglassPower centre_control(std::span<const NodeIndex> row, std::size_t i, con
             kept.inverse_h = stiff_inverse_h;
             if (stiff_quadratic) {
                 for (int a = 0; a < D; ++a) {
-                    for (int b = 0; b < curvature_terms<D>; ++b) kept.curvature(a, b) = f.stiffness_fit.curvature[a * curvature_terms<D> + b][i];
+                    for (int b = 0; b < curvature_terms<D>; ++b) {
+                        kept.curvature(a, b) = f.stiffness_fit.curvature[a * curvature_terms<D> + b][i];
+                    }
                 }
             }
             with_fit_kind<General>(kept, [&](auto curved) {
@@ -507,7 +514,8 @@ HourglassPower centre_control(std::span<const NodeIndex> row, std::size_t i, con
                 for (std::size_t e = 0; e < count; ++e) {
                     const Pair& p = pairs[e];
                     const Vec<D> force_on_j =
-                        (-k * p.weight) * fitted.template error<decltype(curved)::value>(p.offset, stiffness_difference(p.j, p.offset));
+                        (-k * p.weight) *
+                        fitted.template error<decltype(curved)::value>(p.offset, stiffness_difference(p.j, p.offset));
                     if (scatter) {
                         for (int c = 0; c < D; ++c) f.force[c][p.j] += force_on_j[c];
                     }
