@@ -53,8 +53,8 @@ struct HourglassFields {
     std::array<const double*, D> initial_position{};
     const double* initial_diameter = nullptr;
     // Set with SolverOptions::hourglass_stiffness_relaxation: the stiffness form acts on the
-    // controlled variable centres too, against the relaxing reference (NodeStore::reference_position)
-    // over all their controlled pairs, weighed as the damping weighs them.
+    // controlled variable centres too, against the relaxing reference (NodeStore::reference_position):
+    // the damping's fit (its pairs, weights and offsets) applied to the displacements since it.
     std::array<const double*, D> reference_position{};
     // outputs
     std::array<double*, D> force{};  // added to; all null: only the power is computed

@@ -241,9 +241,12 @@ enum class NodeDiameter {
     Stretch,
 };
 
+// The hourglass control's fit around a centre (SolverOptions::hourglass_fit): affine, or with the
+// second derivatives too.
+enum class HourglassFitOrder { Linear, Quadratic };
+
 // Which nodes the hourglass damping (hourglass_coefficient) acts on (docs/validation.md, "The face
 // pairs in the hoop direction").
-enum class HourglassFitOrder { Linear, Quadratic };
 enum class HourglassNodes {
     // Every node in 3D, the lattice regime in 2D (hourglass_damps_every_node): the face's pairing
     // needs a discretised hoop direction, which axisymmetric bodies do not have. The default.
@@ -382,14 +385,14 @@ struct Scene {
     std::string element_reference;
 };
 
-// Whether the hourglass damping acts on every node (SolverOptions::hourglass_nodes), the automatic
-// choice resolved by the scene's geometry.
 // The stiffness form acts on flowing nodes too, against a relaxing reference
 // (SolverOptions::hourglass_stiffness_relaxation).
 inline bool relaxing_stiffness(const SolverOptions& solver) {
     return solver.hourglass_stiffness > 0.0 && solver.hourglass_stiffness_relaxation > 0.0;
 }
 
+// Whether the hourglass damping acts on every node (SolverOptions::hourglass_nodes), the automatic
+// choice resolved by the scene's geometry.
 inline bool hourglass_damps_every_node(const SolverOptions& solver, GeometryKind geometry) {
     if (solver.hourglass_nodes == HourglassNodes::Automatic) return geometry == GeometryKind::ThreeD;
     return solver.hourglass_nodes == HourglassNodes::All;
