@@ -26,7 +26,8 @@ EnergyLedger::EnergyLedger(const SolverOptions& solver)
       hourglass_(solver.hourglass_coefficient > 0.0 || solver.hourglass_stiffness > 0.0),
       stiffness_(solver.hourglass_stiffness > 0.0),
       damping_(solver.hourglass_coefficient > 0.0),
-      quadratic_(solver.hourglass_fit == HourglassFitOrder::Quadratic) {}
+      quadratic_(solver.hourglass_fit == HourglassFitOrder::Quadratic),
+      relaxing_(relaxing_stiffness(solver)) {}
 
 double* EnergyLedger::bond_power(std::size_t count) { return zeroed(bond_power_, count); }
 double* EnergyLedger::hourglass_power(std::size_t count) { return zeroed(hourglass_power_, count); }
@@ -50,7 +51,8 @@ void EnergyLedger::keep_hourglass_fits(HourglassFields<D>& control, std::size_t 
         }
     };
     if (damping_ && quadratic_) point_curvature(damping_curvature_, control.damping_fit);
-    if (stiffness_ && quadratic_) point_curvature(stiffness_curvature_, control.stiffness_fit);
+    // Only relaxed centres fit the stiffness with second derivatives (fixed ones keep the lattice's affine fit).
+    if (relaxing_ && quadratic_) point_curvature(stiffness_curvature_, control.stiffness_fit);
     if (stiffness_) point(stiffness_fit_, control.stiffness_fit);
 }
 

@@ -85,6 +85,7 @@ private:
     bool stiffness_ = false;
     bool damping_ = false;  // the hourglass control's damping form (C_hg > 0)
     bool quadratic_ = false;  // its quadratic fit (SolverOptions::hourglass_fit)
+    bool relaxing_ = false;   // the stiffness on flowing nodes too (relaxing_stiffness)
     bool stress_powers_due_ = false;  // compatible_powers ran this step: book the stress work
     double boundary_work_ = 0.0;
     double hourglass_work_ = 0.0;
