@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -200,6 +201,59 @@ TEST(MemoryLimit, RoomForTheListsButNotTheirKeptPairTermsRunsWithoutThemToTheSam
         }
         ASSERT_EQ(free.nodes().internal_energy[i], tight.nodes().internal_energy[i]) << "node " << i;
     }
+}
+
+std::size_t bytes_of(const Simulation& sim, const std::string& array) {
+    for (const ArrayMemory& a : sim.memory_use()) {
+        if (a.array == array) return a.bytes;
+    }
+    ADD_FAILURE() << "no array \"" << array << "\" in the memory table";
+    return 0;
+}
+
+// A quarter of a 3D copper bar on its anvil (the symmetry planes x = 0 and y = 0 and the anvil),
+// with `connectivity`.
+Scene quarter_bar(ConnectivityMode connectivity) {
+    Scene s = testing::short_copper_bar(GeometryKind::ThreeD, 4);
+    s.bodies[0].connectivity = connectivity;
+    for (int axis : {0, 1}) {
+        PlaneSpec p;
+        p.name = axis == 0 ? "x = 0" : "y = 0";
+        p.kind = PlaneKind::Symmetry;
+        p.axis = axis;
+        p.side = +1;
+        s.planes.push_back(p);
+    }
+    return s;
+}
+
+// What a scene does not need costs no memory (docs/performance.md section 3): without fixed nodes
+// there are no lattice lists (an offset per node each: 24 bytes per node with the ghosts' resolved
+// mirrors), and the map from node ids to nodes is made only when a program looks a node up.
+TEST(MemoryUse, ASceneWithoutFixedNodesCarriesNoLatticeListsAndNoIdMapUntilALookUp) {
+    Simulation sim(quarter_bar(ConnectivityMode::Variable), 2);
+    for (int k = 0; k < 3; ++k) sim.step();
+    const std::size_t real = sim.real_count();
+    const std::size_t ghosts = sim.nodes().size() - real;
+    ASSERT_GT(ghosts, 0u);
+    // The one offset of no rows each (8 bytes), not one per node.
+    EXPECT_LE(bytes_of(sim, "nodes: fixed neighbours"), 8u);
+    EXPECT_LE(bytes_of(sim, "nodes: fixed mirrors"), 8u);
+    EXPECT_LE(bytes_of(sim, "ghosts: resolved lattice mirrors"), 8u);
+    EXPECT_EQ(bytes_of(sim, "external loads: node ids"), 0u);
+    // A look-up makes the map, and finds each node (after the set-up's reorder) by its id.
+    for (const std::uint64_t id : {std::uint64_t{0}, std::uint64_t{real / 2}, std::uint64_t{real - 1}}) {
+        EXPECT_EQ(sim.nodes().id[sim.index_of(id)], id);
+    }
+    EXPECT_EQ(bytes_of(sim, "external loads: node ids"), 4 * real);
+    EXPECT_THROW((void)sim.index_of(real), InputError);
+}
+
+TEST(MemoryUse, ASceneWithFixedNodesKeepsItsLatticeLists) {
+    Simulation sim(quarter_bar(ConnectivityMode::Automatic), 2);
+    for (int k = 0; k < 3; ++k) sim.step();
+    EXPECT_GE(bytes_of(sim, "nodes: fixed neighbours"), 8 * sim.real_count());  // an offset per node and the entries
+    EXPECT_GT(bytes_of(sim, "nodes: fixed mirrors"), 0u);
 }
 
 }  // namespace

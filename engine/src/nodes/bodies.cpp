@@ -298,18 +298,8 @@ std::size_t add_imported_nodes(NodeStore& nodes, const Scene& scene, std::size_t
         nodes.material[i] = static_cast<std::int32_t>(material);
         nodes.connectivity[i] = Connectivity::Variable;
     }
-    // No fixed lists: an empty row per node.
-    auto& rows = nodes.fixed_neighbours;
-    rows.offsets.resize(first + 1);
-    rows.indices.resize(rows.offsets.back());
-    auto& mirrors = nodes.fixed_mirrors;
-    mirrors.offsets.resize(first + 1);
-    mirrors.indices.resize(mirrors.offsets.back());
-    nodes.fixed_mirror_planes.resize(mirrors.offsets.back());
-    for (std::size_t k = 0; k < set.size(); ++k) {
-        rows.offsets.push_back(rows.indices.size());
-        mirrors.offsets.push_back(mirrors.indices.size());
-    }
+    // No fixed lists: the resize above gave every new node an empty row (or none, while no node
+    // has lattice neighbours: node_store.hpp).
     return first;
 }
 

@@ -193,7 +193,7 @@ void GhostSet::build(NodeStore& nodes, std::size_t real_count, GhostReach reach,
             }
         });
     }
-    for (std::size_t i = 0; i < real_count; ++i) {
+    for (std::size_t i = 0; i < nodes.fixed_mirrors.rows() && i < real_count; ++i) {
         if (nodes.connectivity[i] != Connectivity::Fixed) continue;
         for (std::size_t k = nodes.fixed_mirrors.offsets[i]; k < nodes.fixed_mirrors.offsets[i + 1]; ++k) {
             const std::uint8_t m = nodes.fixed_mirror_planes[k];
@@ -418,6 +418,12 @@ void GhostSet::mirror_tensors_to_ghosts(const std::array<double*, 6>& field, int
 const CompressedRows& GhostSet::resolved_fixed_mirrors(const NodeStore& nodes, std::size_t real_count) {
     resolved_.offsets.assign(1, 0);
     resolved_.indices.clear();
+    // No rows where the nodes have no mirrored lattice neighbours (node_store.hpp): every row
+    // reads as empty (CompressedRows::row_or_empty), and there is no offset per node to keep.
+    if (nodes.fixed_mirrors.rows() == 0) {
+        resolved_.offsets.shrink_to_fit();
+        return resolved_;
+    }
     for (std::size_t i = 0; i < real_count; ++i) {
         const bool fixed = nodes.connectivity[i] == Connectivity::Fixed;  // variable nodes find their ghosts by search
         for (std::size_t k = nodes.fixed_mirrors.offsets[i]; fixed && k < nodes.fixed_mirrors.offsets[i + 1]; ++k) {

@@ -21,7 +21,7 @@ template <int D>
 std::array<std::array<std::int64_t, 2>, D> axis_neighbours(const NodeStore& n, std::size_t i) {
     std::array<std::array<std::int64_t, 2>, D> axis;
     for (auto& a : axis) a = {-1, -1};
-    for (NodeIndex j : n.fixed_neighbours.row(i)) {
+    for (NodeIndex j : n.fixed_neighbours.row_or_empty(i)) {
         if (n.connectivity[j] != Connectivity::Fixed) continue;
         int along = -1, nonzero = 0;
         for (int c = 0; c < D; ++c) {

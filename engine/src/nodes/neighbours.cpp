@@ -210,11 +210,11 @@ void find_neighbours(const NodeStore& nodes, InfluenceDistance influence, std::s
     // The rows to make: every centre's, or those of `only`.
     const std::size_t rows = only.empty() ? centres : only.size();
     const auto centre_of = [&](std::size_t k) -> std::size_t { return only.empty() ? k : only[k]; };
-    if (nodes.fixed_neighbours.rows() < centres) {
+    if (nodes.fixed_neighbours.rows() != 0 && nodes.fixed_neighbours.rows() < centres) {
         throw InputError(fmt::format("find_neighbours: fixed lists cover {} of {} centres",
                                      nodes.fixed_neighbours.rows(), centres));
     }
-    if (extra_fixed && extra_fixed->rows() < centres) {
+    if (extra_fixed && extra_fixed->rows() != 0 && extra_fixed->rows() < centres) {
         throw InputError(fmt::format("find_neighbours: extra fixed lists cover {} of {} centres", extra_fixed->rows(), centres));
     }
     // Candidates that outlive switching (see the header): needed only where fixed nodes may switch.
@@ -274,11 +274,11 @@ void find_neighbours(const NodeStore& nodes, InfluenceDistance influence, std::s
     // Lattice pairs link two fixed nodes; a lattice neighbour that has switched is a variable pair
     // now, found by the search like any other node (spec section 2, mixed pairs).
     const auto lattice_neighbour = [&](std::size_t i, NodeIndex j) {
-        for (NodeIndex k : nodes.fixed_neighbours.row(i)) {
+        for (NodeIndex k : nodes.fixed_neighbours.row_or_empty(i)) {
             if (k == j) return true;
         }
         if (extra_fixed) {
-            for (NodeIndex k : extra_fixed->row(i)) {
+            for (NodeIndex k : extra_fixed->row_or_empty(i)) {
                 if (k == j) return true;
             }
         }
@@ -288,11 +288,11 @@ void find_neighbours(const NodeStore& nodes, InfluenceDistance influence, std::s
     const auto visit = [&](std::size_t i, auto&& emit) {
         const bool fixed = nodes.connectivity[i] == Connectivity::Fixed;
         if (fixed) {
-            for (NodeIndex j : nodes.fixed_neighbours.row(i)) {
+            for (NodeIndex j : nodes.fixed_neighbours.row_or_empty(i)) {
                 if (candidates || nodes.connectivity[j] == Connectivity::Fixed) emit(j);
             }
             if (extra_fixed) {
-                for (NodeIndex j : extra_fixed->row(i)) {
+                for (NodeIndex j : extra_fixed->row_or_empty(i)) {
                     if (candidates || nodes.connectivity[j] == Connectivity::Fixed) emit(j);  // a ghost has its source's mode
                 }
             }
@@ -406,7 +406,7 @@ void find_neighbours(const NodeStore& nodes, InfluenceDistance influence, std::s
 
     // Two passes, count and fill, straight into the output: no per-block buffers, so the peak
     // memory of a search is the lists themselves (the search runs once in many steps with a skin).
-    resize_with_slack(out.offsets, rows + 1);
+    resize_discarding(out.offsets, rows + 1);
     out.offsets[0] = 0;
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rows, search_block), [&](const tbb::blocked_range<std::size_t>& r) {
         for (std::size_t k = r.begin(); k != r.end(); ++k) {
@@ -417,7 +417,7 @@ void find_neighbours(const NodeStore& nodes, InfluenceDistance influence, std::s
     });
     for (std::size_t k = 0; k < rows; ++k) out.offsets[k + 1] += out.offsets[k];
     if (scratch.check_entries && only.empty()) scratch.check_entries(out.offsets[rows]);
-    resize_with_slack(out.indices, out.offsets[rows]);
+    resize_discarding(out.indices, out.offsets[rows]);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rows, search_block), [&](const tbb::blocked_range<std::size_t>& r) {
         for (std::size_t k = r.begin(); k != r.end(); ++k) {
             std::size_t next = out.offsets[k];
@@ -450,7 +450,7 @@ void filter_rows(const NodeStore& nodes, double a, const CompressedRows& candida
     const Connectivity* mode = nodes.connectivity.data();
     const std::int32_t* body = nodes.body.data();
     const std::size_t* candidate_offsets = candidates.offsets.data();
-    const std::uint32_t* lattice_counts = lattice_entries.data();
+    const std::uint32_t* lattice_counts = lattice_entries.empty() ? nullptr : lattice_entries.data();  // none: 0 per row
     std::size_t* counts = out.offsets.data();
     std::uint8_t* keep_out = keep.data();
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rows, filter_block), [&](const tbb::blocked_range<std::size_t>& r) {
@@ -466,7 +466,7 @@ void filter_rows(const NodeStore& nodes, double a, const CompressedRows& candida
         const double influence = a;
         for (std::size_t i = r.begin(); i != r.end(); ++i) {
             const std::size_t first = candidate_offsets[i], last = candidate_offsets[i + 1];
-            const std::size_t lattice_end = std::min(last, first + lattice_counts[i]);
+            const std::size_t lattice_end = lattice_counts ? std::min(last, first + lattice_counts[i]) : first;
             const bool fixed_centre = modes[i] == Connectivity::Fixed;
             std::array<double, D> xi;
             for (int c = 0; c < D; ++c) xi[c] = xs[c][i];
@@ -497,7 +497,7 @@ void filter_rows(const NodeStore& nodes, double a, const CompressedRows& candida
         }
     });
     for (std::size_t i = 0; i < rows; ++i) out.offsets[i + 1] += out.offsets[i];
-    resize_with_slack(out.indices, out.offsets[rows]);
+    resize_discarding(out.indices, out.offsets[rows]);
     // Pass 2: copy the kept entries in order. Without a branch on keep[e], which no predictor
     // guesses (about a third of the candidates go): every entry is written at the next free place
     // of the row, and only a kept one moves that place on, so each place ends with the kept entry
@@ -524,11 +524,11 @@ void filter_candidates(const NodeStore& nodes, double a, const CompressedRows& c
                        const std::vector<std::uint32_t>& lattice_entries, CompressedRows& out,
                        std::vector<std::uint8_t>& keep) {
     const std::size_t rows = candidates.rows();
-    if (lattice_entries.size() < rows) {
+    if (!lattice_entries.empty() && lattice_entries.size() < rows) {
         throw InputError(fmt::format("filter_candidates: {} lattice counts for {} rows", lattice_entries.size(), rows));
     }
     keep.resize(candidates.entries());
-    resize_with_slack(out.offsets, rows + 1);
+    resize_discarding(out.offsets, rows + 1);
     out.offsets[0] = 0;
     if (nodes.dim() == 2) {
         filter_rows<2>(nodes, a, candidates, lattice_entries, out, keep);
@@ -545,10 +545,13 @@ CompressedRows find_neighbours_brute_force(const NodeStore& nodes, double a, std
     for (std::size_t i = 0; i < centres; ++i) {
         const bool fixed = nodes.connectivity[i] == Connectivity::Fixed;
         if (fixed) {
-            for (NodeIndex j : nodes.fixed_neighbours.row(i)) {
+            for (NodeIndex j : nodes.fixed_neighbours.row_or_empty(i)) {
                 if (nodes.connectivity[j] == Connectivity::Fixed) rows[i].push_back(j);
             }
-            if (extra_fixed) rows[i].insert(rows[i].end(), extra_fixed->row(i).begin(), extra_fixed->row(i).end());
+            if (extra_fixed) {
+                const auto extra = extra_fixed->row_or_empty(i);
+                rows[i].insert(rows[i].end(), extra.begin(), extra.end());
+            }
         }
         for (std::size_t j = 0; j < nodes.size(); ++j) {
             if (j == i || (fixed && nodes.body[j] == nodes.body[i] && nodes.connectivity[j] == Connectivity::Fixed)) continue;

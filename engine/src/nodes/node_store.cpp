@@ -78,28 +78,34 @@ namespace {
 // removed node (keeping `tags`, one per entry, aligned).
 void resize_rows(CompressedRows& rows, std::vector<std::uint8_t>* tags, std::size_t count) {
     const std::size_t old_rows = rows.rows();
+    if (old_rows == 0) return;  // no rows: every row is empty, however many nodes (node_store.hpp)
     if (old_rows <= count) {
         rows.offsets.resize(count + 1, rows.offsets.back());
         return;
     }
-    CompressedRows kept;
-    std::vector<std::uint8_t> kept_tags;
-    kept.offsets.reserve(count + 1);
+    // In place (an entry only ever moves towards the front): the ghosts go at every reorder, and a
+    // copy of the lattice lists beside them was the peak of a 2D fixed run (126 bytes per node).
+    std::size_t kept = 0, start = rows.offsets[0];
     for (std::size_t i = 0; i < count; ++i) {
-        for (std::size_t k = rows.offsets[i]; k < rows.offsets[i + 1]; ++k) {
+        const std::size_t end = rows.offsets[i + 1];
+        for (std::size_t k = start; k < end; ++k) {
             if (rows.indices[k] >= count) continue;
-            kept.indices.push_back(rows.indices[k]);
-            if (tags) kept_tags.push_back((*tags)[k]);
+            rows.indices[kept] = rows.indices[k];
+            if (tags) (*tags)[kept] = (*tags)[k];
+            ++kept;
         }
-        kept.offsets.push_back(kept.indices.size());
+        start = end;
+        rows.offsets[i + 1] = kept;
     }
-    rows = std::move(kept);
-    if (tags) *tags = std::move(kept_tags);
+    rows.offsets.resize(count + 1);
+    rows.indices.resize(kept);
+    if (tags) tags->resize(kept);
 }
 
 // Rewrites rows in a new node order (new node k is old node new_to_old[k]).
 void permute_rows(CompressedRows& rows, std::vector<std::uint8_t>* tags, std::span<const NodeIndex> new_to_old,
                   const std::vector<NodeIndex>& old_to_new) {
+    if (rows.rows() == 0) return;
     CompressedRows out;
     std::vector<std::uint8_t> out_tags;
     out.offsets.reserve(new_to_old.size() + 1);
@@ -127,6 +133,14 @@ void NodeStore::resize(std::size_t count) {
     for_each_field([count](std::string_view, auto& field) { resize_with_slack(field, count); });
     resize_rows(fixed_neighbours, nullptr, count);
     resize_rows(fixed_mirrors, &fixed_mirror_planes, count);
+}
+
+void NodeStore::release_empty_lattice_rows() {
+    if (fixed_neighbours.entries() == 0 && fixed_mirrors.entries() == 0) {
+        fixed_neighbours = CompressedRows{};  // the arrays freed, not only emptied
+        fixed_mirrors = CompressedRows{};
+        fixed_mirror_planes = std::vector<std::uint8_t>{};
+    }
 }
 
 void NodeStore::carry_reference_positions() {
@@ -263,8 +277,11 @@ void NodeStore::read_state(StateReader& in) {
         in.array(field);
         if (field.size() != count) in.fail("a node field has the wrong length (a damaged checkpoint)");
     });
-    read_rows(in, fixed_neighbours, count, count);
-    read_rows(in, fixed_mirrors, count, count);
+    // A row per node, or none (node_store.hpp).
+    for (CompressedRows* rows : {&fixed_neighbours, &fixed_mirrors}) {
+        read_rows(in, *rows, std::numeric_limits<std::size_t>::max(), count);
+        if (rows->rows() != 0 && rows->rows() != count) in.fail("the lattice lists do not fit the nodes (a damaged checkpoint)");
+    }
     in.array(fixed_mirror_planes);
     if (fixed_mirror_planes.size() != fixed_mirrors.entries()) in.fail("the mirrored lattice lists are damaged");
 }

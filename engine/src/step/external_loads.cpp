@@ -9,26 +9,26 @@
 
 namespace gpa {
 
-bool ExternalLoads::map_ids(const NodeStore& nodes, std::size_t real) {
-    constexpr std::uint32_t unseen = UINT32_MAX;
-    index_of_id_.assign(real, unseen);
+bool ExternalLoads::check_ids(const NodeStore& nodes, std::size_t real) {
+    std::vector<bool> seen(real, false);
     for (std::size_t i = 0; i < real; ++i) {
         const std::uint32_t id = nodes.id[i];
-        if (id >= real || index_of_id_[id] != unseen) {
-            index_of_id_.clear();
-            return false;
-        }
-        index_of_id_[id] = static_cast<std::uint32_t>(i);
+        if (id >= real || seen[id]) return false;
+        seen[id] = true;
     }
     return true;
 }
 
-std::size_t ExternalLoads::index_of(std::uint64_t id) const {
-    if (id >= index_of_id_.size()) {
+std::size_t ExternalLoads::index_of(const NodeStore& nodes, std::size_t real, std::uint64_t id) const {
+    if (id >= real) {
         throw InputError(fmt::format("node id {}: no particle node has it (the ids of this run are 0 to {}, one per particle node "
                                      "in the order the scene's bodies were filled{})",
-                                     id, index_of_id_.empty() ? 0 : index_of_id_.size() - 1,
-                                     index_of_id_.empty() ? "; this run has none" : ""));
+                                     id, real == 0 ? 0 : real - 1, real == 0 ? "; this run has none" : ""));
+    }
+    if (index_of_id_.size() != real) {
+        // The ids are 0 ... real - 1, each once: checked at the set-up and at every restore.
+        index_of_id_.assign(real, 0);
+        for (std::size_t i = 0; i < real; ++i) index_of_id_[nodes.id[i]] = static_cast<std::uint32_t>(i);
     }
     return index_of_id_[id];
 }
@@ -42,12 +42,12 @@ void ExternalLoads::add_force(std::uint32_t id, const std::array<double, 3>& for
     }
 }
 
-void ExternalLoads::add_to_forces(NodeStore& nodes) {
+void ExternalLoads::add_to_forces(NodeStore& nodes, std::size_t real) {
     applied_to_.clear();
     half_step_.clear();
     const int dim = nodes.dim();
     for (const Load& load : pending_) {
-        const std::size_t i = index_of(load.id);
+        const std::size_t i = index_of(nodes, real, load.id);
         applied_to_.push_back(i);
         std::array<double, 3> v{0, 0, 0};
         for (int c = 0; c < dim; ++c) {

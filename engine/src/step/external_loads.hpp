@@ -30,12 +30,14 @@ namespace gpa {
 
 class ExternalLoads {
 public:
-    // Where each id is: made at the set-up and again whenever the nodes are reordered or restored.
-    // The ids of the real nodes are 0 ... real - 1, each once; false (and no map) when they are not.
-    bool map_ids(const NodeStore& nodes, std::size_t real);
-    void forget_ids() { index_of_id_.clear(); }
-    // The index of the real node with this id now. Throws InputError for an id no real node has.
-    std::size_t index_of(std::uint64_t id) const;
+    // Where each id is: a map made at the first look-up after the set-up, a reorder or a restore
+    // (forget_ids), so that a run no program looks into carries none (4 bytes per node).
+    // The ids of the real nodes are 0 ... real - 1, each once (check_ids: false when they are not).
+    static bool check_ids(const NodeStore& nodes, std::size_t real);
+    void forget_ids() { std::vector<std::uint32_t>().swap(index_of_id_); }
+    // The index of the real node with this id now, of `nodes` with `real` real nodes (the run's).
+    // Throws InputError for an id no real node has.
+    std::size_t index_of(const NodeStore& nodes, std::size_t real, std::uint64_t id) const;
 
     // Adds F to the node's external force in the next velocity update (forces on one node add up).
     void add_force(std::uint32_t id, const std::array<double, 3>& force);
@@ -43,7 +45,7 @@ public:
 
     // In the velocity update, before it: the forces join the nodes' forces, and v^{n+1/2} of their
     // nodes is kept. After it (and the prescribed components): their work; then they are cleared.
-    void add_to_forces(NodeStore& nodes);
+    void add_to_forces(NodeStore& nodes, std::size_t real);
     void book(const NodeStore& nodes, double dt_avg);
 
     // Work done on the bodies outside the step (a velocity set between steps), J.
@@ -70,7 +72,7 @@ private:
     std::vector<Load> pending_;                    // in the order they were given, one per id
     std::vector<std::size_t> applied_to_;          // the node of each pending load, during the update
     std::vector<std::array<double, 3>> half_step_; // its v^{n+1/2}
-    std::vector<std::uint32_t> index_of_id_;       // id -> index of a real node
+    mutable std::vector<std::uint32_t> index_of_id_;  // id -> index of a real node; empty until a look-up
     double work_ = 0.0, last_force_work_ = 0.0;
 };
 

@@ -54,9 +54,14 @@ void NeighbourLists::set_up(bool constant) {
 }
 
 void NeighbourLists::invalidate() {
-    lists_.clear();  // rebuilt in the new numbering by the next update
+    // Rebuilt in the new numbering by the next update; their memory freed now, not only emptied,
+    // so that the renumbering of the nodes (its copies of the lattice lists) has it.
+    lists_ = CompressedRows{};
+    candidates_ = CompressedRows{};
+    found_ = CompressedRows{};
+    std::vector<std::uint8_t>().swap(keep_scratch_);
+    forget_kept_arrays();
     search_due_ = true;
-    kept_rows_ = 0;
 }
 
 void NeighbourLists::forget_kept_arrays() {
@@ -297,11 +302,16 @@ void NeighbourLists::search_candidates(NodeStore& nodes, std::size_t real, Ghost
     any_quiet_ = std::find(quiet_.begin(), quiet_.end(), std::uint8_t{1}) != quiet_.end();
     searched_fixed_.resize(real);
     for (std::size_t i = 0; i < real; ++i) searched_fixed_[i] = nodes.connectivity[i] == Connectivity::Fixed;
-    lattice_entries_.assign(real, 0);
-    for (std::size_t i = 0; i < real; ++i) {
+    // The lattice counts only where some row has lattice entries (filter_candidates reads none as 0).
+    if (nodes.fixed_neighbours.rows() == 0 && (!mirrored || mirrored->rows() == 0)) {
+        std::vector<std::uint32_t>().swap(lattice_entries_);
+    } else {
+        lattice_entries_.assign(real, 0);
+    }
+    for (std::size_t i = 0; i < real && !lattice_entries_.empty(); ++i) {
         if (nodes.connectivity[i] != Connectivity::Fixed) continue;
         lattice_entries_[i] =
-            static_cast<std::uint32_t>(nodes.fixed_neighbours.row(i).size() + (mirrored ? mirrored->row(i).size() : 0));
+            static_cast<std::uint32_t>(nodes.fixed_neighbours.row_or_empty(i).size() + (mirrored ? mirrored->row_or_empty(i).size() : 0));
     }
     for (int c = 0; c < nodes.dim(); ++c) searched_position_[c].assign(nodes.position[c].begin(), nodes.position[c].begin() + real);
     searched_diameter_.assign(nodes.diameter.begin(), nodes.diameter.begin() + real);
@@ -509,7 +519,9 @@ void NeighbourLists::read_state(StateReader& in, int dim, std::size_t node_count
     in.array(quiet_);
     in.array(searched_fixed_);
     any_quiet_ = std::find(quiet_.begin(), quiet_.end(), std::uint8_t{1}) != quiet_.end();
-    if (quiet_.size() != searched_fixed_.size() || quiet_.size() != lattice_entries_.size()) in.fail("its neighbour lists are damaged");
+    if (quiet_.size() != searched_fixed_.size() || (!lattice_entries_.empty() && quiet_.size() != lattice_entries_.size())) {
+        in.fail("its neighbour lists are damaged");
+    }
     for (int c = 0; c < dim; ++c) in.array(searched_position_[c]);
     in.array(searched_diameter_);
     rows_searched_alone_ = in.value<std::uint8_t>() != 0;

@@ -81,7 +81,8 @@ public:
     std::size_t row_searches() const { return row_searches_; }
     std::size_t rows_searched() const { return rows_searched_; }
 
-    // The nodes were renumbered (NodeStore::permute): search again in the new numbering.
+    // The nodes are renumbered (NodeStore::permute): search again in the new numbering. Frees the
+    // lists and candidates at once (called before the renumbering, whose copies then take their place).
     void invalidate();
 
     // Geometry phase, after the diameters: decides whether the candidates are stale, then places

@@ -175,7 +175,8 @@ void Simulation::Impl::setup() {
     if (particles && scene.solver.reorder_interval > 0) reorder();
     regroup_materials();
     regions.index(nodes, real);
-    external.map_ids(nodes, real);
+    if (!ExternalLoads::check_ids(nodes, real)) throw NumericalError("the nodes' ids are not 0 ... n - 1, each once");
+    external.forget_ids();
     contact.set_up(real);
     neighbour_lists.set_up(!contact.separation() && ghosts.empty() && !needs_search(nodes, real) &&
                            !switching_part.any_automatic());
@@ -216,11 +217,11 @@ void Simulation::Impl::regroup_materials() {
 
 void Simulation::Impl::reorder() {
     nodes.resize(real);  // ghosts are rebuilt after every move
+    neighbour_lists.invalidate();  // rebuilt in the new numbering by the neighbours phase; freed first
     const double cell = bulk_interaction_radius(nodes, a().value(), real);
     nodes.permute(locality_order(nodes, cell, 0, real));
-    neighbour_lists.invalidate();  // rebuilt in the new numbering by the neighbours phase
     switching_part.forget_lattice_axes();
-    external.map_ids(nodes, real);
+    external.forget_ids();  // made again at the next look-up
     regroup_materials();
     regions.index(nodes, real);
 }
@@ -441,7 +442,7 @@ void Simulation::Impl::integrate(double dt_avg) {
     HeldNodes& held = regions.particles();
     if (!held.empty()) held.capture({velocity[0], velocity[1], velocity[2]}, d);
     ledger.keep_half_step_velocities(nodes);
-    if (external.forces_pending()) external.add_to_forces(nodes);  // a program's loads join the forces
+    if (external.forces_pending()) external.add_to_forces(nodes, real);  // a program's loads join the forces
     rigid_planes.apply_friction(ghosts, nodes, real, dt_avg);  // Coulomb friction joins the forces
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, real, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
         for (int c = 0; c < d; ++c) {
@@ -713,13 +714,13 @@ void check_vector(const std::array<double, 3>& v, int dim, const char* call, con
 
 }  // namespace
 
-std::size_t Simulation::index_of(std::uint64_t id) const { return impl_->external.index_of(id); }
+std::size_t Simulation::index_of(std::uint64_t id) const { return impl_->external.index_of(impl_->nodes, impl_->real, id); }
 
 void Simulation::apply_force(std::uint64_t id, const std::array<double, 3>& force) {
     Impl& im = *impl_;
     if (im.failed) throw InputError("Simulation::apply_force: an earlier step failed");
     check_vector(force, im.dim(), "apply_force", "force");
-    (void)im.external.index_of(id);
+    (void)im.external.index_of(im.nodes, im.real, id);
     im.external.add_force(static_cast<std::uint32_t>(id), force);
 }
 
@@ -727,7 +728,7 @@ void Simulation::set_velocity(std::uint64_t id, const std::array<double, 3>& vel
     Impl& im = *impl_;
     if (im.failed) throw InputError("Simulation::set_velocity: an earlier step failed");
     check_vector(velocity, im.dim(), "set_velocity", "velocity");
-    const std::size_t i = im.external.index_of(id);
+    const std::size_t i = im.external.index_of(im.nodes, im.real, id);
     // A component a region holds keeps the region's velocity (set_region_velocity changes it).
     if (const std::uint8_t region = im.nodes.velocity_region[i]; region != 0) {
         const PrescribedVelocitySpec& spec = im.scene.prescribed_velocities[region - 1u];
@@ -958,7 +959,8 @@ void Simulation::Impl::read_state(StateReader& in) {
     for (std::size_t b = 0; b < body_kinetic.size(); ++b) totals.bodies[b].kinetic_energy = body_kinetic[b];
     // The held nodes in the checkpoint's numbering: the same count per region as the scene's.
     regions.check_restored(in, nodes, real);
-    if (!external.map_ids(nodes, real)) in.fail("its node ids are not those of the scene's nodes (a damaged checkpoint)");
+    if (!ExternalLoads::check_ids(nodes, real)) in.fail("its node ids are not those of the scene's nodes (a damaged checkpoint)");
+    external.forget_ids();
 }
 
 bool Simulation::can_checkpoint() const { return true; }

@@ -17,6 +17,7 @@ Switching::Switching(const Scene& scene) {
 
 void Switching::prepare_lattices(const Scene& scene, NodeStore& nodes, std::size_t real, std::size_t first_scene_plane) const {
     const auto drop_variable_rows = [&](CompressedRows& rows, std::vector<std::uint8_t>* tags) {
+        if (rows.rows() == 0) return;  // no lattice lists (node_store.hpp)
         CompressedRows kept;
         std::vector<std::uint8_t> kept_tags;
         kept.offsets.assign(1, 0);
@@ -34,6 +35,7 @@ void Switching::prepare_lattices(const Scene& scene, NodeStore& nodes, std::size
     };
     drop_variable_rows(nodes.fixed_neighbours, nullptr);
     drop_variable_rows(nodes.fixed_mirrors, &nodes.fixed_mirror_planes);
+    nodes.release_empty_lattice_rows();
     for (std::size_t b = 0; b < scene.bodies.size(); ++b) {
         if (body_mode_[b] == ConnectivityMode::Variable || scene.bodies[b].discretisation != Discretisation::Particles) continue;
         for (std::size_t k = 0; k < scene.planes.size(); ++k) {
@@ -41,6 +43,7 @@ void Switching::prepare_lattices(const Scene& scene, NodeStore& nodes, std::size
             bool touches = false;
             for (std::size_t i = 0; i < real && !touches; ++i) {
                 if (nodes.body[i] != static_cast<std::int32_t>(b)) continue;
+                if (i >= nodes.fixed_mirrors.rows()) break;  // no mirrored lattice neighbours anywhere
                 for (std::size_t e = nodes.fixed_mirrors.offsets[i]; e < nodes.fixed_mirrors.offsets[i + 1]; ++e) {
                     touches |= (nodes.fixed_mirror_planes[e] >> bit) & 1u;
                 }

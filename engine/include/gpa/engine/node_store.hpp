@@ -51,6 +51,9 @@ public:
     // stiffness never calls it and carries nothing.
     void carry_reference_positions();
     bool carries_reference_positions() const { return carries_reference_; }
+    // Frees the lattice lists when no row has an entry (fixed_neighbours below): after the set-up,
+    // and when nodes have switched.
+    void release_empty_lattice_rows();
 
     // --- state carried from step to step -------------------------------------------------
     std::array<std::vector<double>, 3> position;   // m
@@ -106,11 +109,15 @@ public:
     std::vector<double> stable_length;                     // c / omega of the node (kernels.hpp)
     std::array<std::vector<double>, 3> force;              // N (a ring's force in axisymmetric)
 
-    // Lattice neighbours of each node for fixed connectivity (spec section 2).
+    // Lattice neighbours of each node for fixed connectivity (spec section 2). Either a row per
+    // node or no rows at all: while no node has lattice neighbours (a scene without fixed nodes,
+    // or once every one has switched) the lists hold nothing, not an offset per node, and every
+    // row reads as empty (CompressedRows::row_or_empty, the way to read them).
     CompressedRows fixed_neighbours;
     // Lattice neighbours that lie across a symmetry or rigid plane: the ghost image of node
     // fixed_mirrors.indices[k] across the planes in bit mask fixed_mirror_planes[k] (spec section 7:
     // "a fixed-connectivity node next to a plane has its ghost images in its neighbour list").
+    // Rows as above: one per node, or none.
     CompressedRows fixed_mirrors;
     std::vector<std::uint8_t> fixed_mirror_planes;
 
