@@ -59,7 +59,7 @@ void NeighbourLists::invalidate() {
     lists_ = CompressedRows{};
     candidates_ = CompressedRows{};
     found_ = CompressedRows{};
-    std::vector<std::uint8_t>().swap(keep_scratch_);
+    std::vector<std::uint64_t>().swap(keep_scratch_);
     forget_kept_arrays();
     search_due_ = true;
 }

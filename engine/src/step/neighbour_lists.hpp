@@ -147,7 +147,7 @@ private:
     // quiet itself), makes the candidates stale.
     std::vector<std::uint8_t> quiet_, searched_fixed_;
     bool any_quiet_ = false;
-    std::vector<std::uint8_t> keep_scratch_;
+    std::vector<std::uint64_t> keep_scratch_;  // filter_candidates' kept entries, as bits
     // Per row, the position and diameter of its node when the row was last searched (all from
     // one moment after a full search; rows searched alone since take their own moment).
     std::array<std::vector<double>, 3> searched_position_;

@@ -30,8 +30,9 @@ std::string format_bytes(double bytes);
 // 3D 445 and about 200, and since issue 23 the 48 bytes of a 3D node's B).
 double bytes_per_node_besides_lists(int dim);
 // Memory per candidate pair of the neighbour lists: the candidate index (4 bytes), its keep
-// flag (1) and its share of the cut lists (4).
-constexpr double bytes_per_list_entry = 9.0;
+// bit (1/8; the word each row starts is in the bytes per node above) and its share of the cut
+// lists (4).
+constexpr double bytes_per_list_entry = 8.125;
 // And per list entry the term a step keeps for its sweeps (R_ij / r_ij^2, 8 bytes, with the 1/8 the
 // array grows by beyond what it needs; NeighbourLists::keep_pairs). A run whose lists fit the
 // memory limit without them, but not with them, goes without them: its forces, energy booking and

@@ -96,7 +96,7 @@ CompressedRows find_neighbours(const NodeStore& nodes, double influence_distance
 // Deterministic and independent of the thread count.
 void filter_candidates(const NodeStore& nodes, double influence_distance, const CompressedRows& candidates,
                        const std::vector<std::uint32_t>& lattice_entries, CompressedRows& out,
-                       std::vector<std::uint8_t>& keep);
+                       std::vector<std::uint64_t>& keep);
 
 // The same lists from an all-pairs loop: the check for find_neighbours. O(n^2).
 CompressedRows find_neighbours_brute_force(const NodeStore& nodes, double influence_distance,
