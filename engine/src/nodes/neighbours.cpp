@@ -481,34 +481,32 @@ void filter_rows(const NodeStore& nodes, double a, const CompressedRows& candida
             const std::int32_t body_i = bodies[i];
             std::size_t kept = 0;
             std::uint64_t* word = keep_out + first_keep_word(i, first);
-            std::uint64_t bits = 0;
-            unsigned bit = 0;
-            for (std::size_t e = first; e < last; ++e) {
-                const NodeIndex j = js[e];
-                const bool both_fixed = fixed_centre && modes[j] == Connectivity::Fixed;
-                bool pair;
-                if (e < lattice_end && both_fixed) {
-                    pair = true;
-                } else if (both_fixed && bodies[j] == body_i) {
-                    pair = false;
-                } else {
-                    double r2 = 0.0;
-                    for (int c = 0; c < D; ++c) {
-                        const double dx = xs[c][j] - xi[c];
-                        r2 += dx * dx;
+            // The row in runs of up to 64 entries, one word each: no test for a full word per entry.
+            for (std::size_t start = first; start < last; start += 64) {
+                const std::size_t stop = std::min(last, start + 64);
+                std::uint64_t bits = 0;
+                for (std::size_t e = start; e < stop; ++e) {
+                    const NodeIndex j = js[e];
+                    const bool both_fixed = fixed_centre && modes[j] == Connectivity::Fixed;
+                    bool pair;
+                    if (e < lattice_end && both_fixed) {
+                        pair = true;
+                    } else if (both_fixed && bodies[j] == body_i) {
+                        pair = false;
+                    } else {
+                        double r2 = 0.0;
+                        for (int c = 0; c < D; ++c) {
+                            const double dx = xs[c][j] - xi[c];
+                            r2 += dx * dx;
+                        }
+                        // The search's rule, within_influence(r^2, h_ij) (weights.hpp).
+                        pair = within_influence(r2, pair_smoothing_length(influence, di, ds[j]));
                     }
-                    // The search's rule, within_influence(r^2, h_ij) (weights.hpp).
-                    pair = within_influence(r2, pair_smoothing_length(influence, di, ds[j]));
+                    bits |= std::uint64_t{pair} << (e - start);
+                    kept += pair;
                 }
-                bits |= std::uint64_t{pair} << bit;
-                kept += pair;
-                if (++bit == 64) {
-                    *word++ = bits;
-                    bits = 0;
-                    bit = 0;
-                }
+                *word++ = bits;
             }
-            if (bit != 0) *word = bits;
             counts[i + 1] = kept;
         }
     });
