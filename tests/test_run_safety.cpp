@@ -6,6 +6,8 @@
 #include <cmath>
 #include <cstdint>
 #include <string>
+#include <thread>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -247,6 +249,29 @@ TEST(MemoryUse, ASceneWithoutFixedNodesCarriesNoLatticeListsAndNoIdMapUntilALook
     }
     EXPECT_EQ(bytes_of(sim, "external loads: node ids"), 4 * real);
     EXPECT_THROW((void)sim.index_of(real), InputError);
+}
+
+// index_of only reads as far as a program can tell (docs/api.md: several threads may call it between
+// steps), though its first call after a reorder makes the map. Without the lock around that, the
+// threads would build the map over one another: a wrong node or a crash here, a data race under a
+// thread sanitizer (which CI does not run).
+TEST(MemoryUse, ThreadsLookingNodesUpAtOnceAfterAReorderEachFindEveryNode) {
+    Scene scene = quarter_bar(ConnectivityMode::Variable);
+    scene.solver.reorder_interval = 2;
+    Simulation sim(scene, 2);
+    for (int k = 0; k < 5; ++k) sim.step();
+    const std::size_t real = sim.real_count();
+    std::vector<std::vector<std::size_t>> found(4, std::vector<std::size_t>(real));
+    std::vector<std::thread> threads;
+    for (auto& mine : found) {
+        threads.emplace_back([&sim, &mine, real] {
+            for (std::size_t id = 0; id < real; ++id) mine[id] = sim.index_of(id);
+        });
+    }
+    for (auto& t : threads) t.join();
+    for (std::size_t id = 0; id < real; ++id) {
+        for (const auto& mine : found) ASSERT_EQ(sim.nodes().id[mine[id]], id) << "id " << id;
+    }
 }
 
 TEST(MemoryUse, ASceneWithFixedNodesKeepsItsLatticeLists) {

@@ -25,10 +25,14 @@ std::size_t ExternalLoads::index_of(const NodeStore& nodes, std::size_t real, st
                                      "in the order the scene's bodies were filled{})",
                                      id, real == 0 ? 0 : real - 1, real == 0 ? "; this run has none" : ""));
     }
-    if (index_of_id_.size() != real) {
-        // The ids are 0 ... real - 1, each once: checked at the set-up and at every restore.
-        index_of_id_.assign(real, 0);
-        for (std::size_t i = 0; i < real; ++i) index_of_id_[nodes.id[i]] = static_cast<std::uint32_t>(i);
+    if (!mapped_.load(std::memory_order_acquire)) {
+        const std::lock_guard<std::mutex> lock(map_mutex_);
+        if (!mapped_.load(std::memory_order_relaxed)) {
+            // The ids are 0 ... real - 1, each once: checked at the set-up and at every restore.
+            index_of_id_.assign(real, 0);
+            for (std::size_t i = 0; i < real; ++i) index_of_id_[nodes.id[i]] = static_cast<std::uint32_t>(i);
+            mapped_.store(true, std::memory_order_release);
+        }
     }
     return index_of_id_[id];
 }

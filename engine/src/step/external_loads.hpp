@@ -17,8 +17,10 @@
 // opposite sign (Totals::boundary_work, external_work).
 
 #include <array>
+#include <atomic>
 #include <cstddef>
 #include <cstdint>
+#include <mutex>
 #include <vector>
 
 #include "gpa/engine/memory_use.hpp"
@@ -31,12 +33,17 @@ namespace gpa {
 class ExternalLoads {
 public:
     // Where each id is: a map made at the first look-up after the set-up, a reorder or a restore
-    // (forget_ids), so that a run no program looks into carries none (4 bytes per node).
-    // The ids of the real nodes are 0 ... real - 1, each once (check_ids: false when they are not).
+    // (forget_ids, from the step's thread), so that a run no program looks into carries none (4
+    // bytes per node). The ids of the real nodes are 0 ... real - 1, each once (check_ids: false
+    // when they are not).
     static bool check_ids(const NodeStore& nodes, std::size_t real);
-    void forget_ids() { std::vector<std::uint32_t>().swap(index_of_id_); }
+    void forget_ids() {
+        std::vector<std::uint32_t>().swap(index_of_id_);
+        mapped_.store(false, std::memory_order_relaxed);
+    }
     // The index of the real node with this id now, of `nodes` with `real` real nodes (the run's).
-    // Throws InputError for an id no real node has.
+    // Throws InputError for an id no real node has. Several threads may call it at once between
+    // steps (docs/api.md): the first makes the map, under a lock, and the others wait for it.
     std::size_t index_of(const NodeStore& nodes, std::size_t real, std::uint64_t id) const;
 
     // Adds F to the node's external force in the next velocity update (forces on one node add up).
@@ -73,6 +80,8 @@ private:
     std::vector<std::size_t> applied_to_;          // the node of each pending load, during the update
     std::vector<std::array<double, 3>> half_step_; // its v^{n+1/2}
     mutable std::vector<std::uint32_t> index_of_id_;  // id -> index of a real node; empty until a look-up
+    mutable std::atomic<bool> mapped_{false};         // index_of_id_ is made
+    mutable std::mutex map_mutex_;
     double work_ = 0.0, last_force_work_ = 0.0;
 };
 
