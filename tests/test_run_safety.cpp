@@ -218,15 +218,7 @@ std::size_t bytes_of(const Simulation& sim, const std::string& array) {
 Scene quarter_bar(ConnectivityMode connectivity) {
     Scene s = testing::short_copper_bar(GeometryKind::ThreeD, 4);
     s.bodies[0].connectivity = connectivity;
-    for (int axis : {0, 1}) {
-        PlaneSpec p;
-        p.name = axis == 0 ? "x = 0" : "y = 0";
-        p.kind = PlaneKind::Symmetry;
-        p.axis = axis;
-        p.side = +1;
-        s.planes.push_back(p);
-    }
-    return s;
+    return testing::with_quarter_planes(s);
 }
 
 // What a scene does not need costs no memory (docs/performance.md section 3): without fixed nodes

@@ -135,15 +135,7 @@ Scene three_d_cylinder(int radial_cells) {
     bar.origin = {0.0, 0.0, 0.0};
     bar.velocity = {0.0, 0.0, -305.0};
     scene.planes[0].axis = 2;
-    for (int axis : {0, 1}) {
-        PlaneSpec p;
-        p.name = axis == 0 ? "x = 0" : "y = 0";
-        p.kind = PlaneKind::Symmetry;
-        p.axis = axis;
-        p.side = +1;
-        scene.planes.push_back(p);
-    }
-    return scene;
+    return testing::with_quarter_planes(scene);
 }
 
 // The 3D node diameter (SolverOptions::node_diameter, kernels.hpp): with "stretch" (the default)

@@ -8,12 +8,14 @@
 #include <filesystem>
 #include <map>
 #include <string>
+#include <utility>
 
 #include <gtest/gtest.h>
 
 #include "gpa/engine/simulation.hpp"
 #include "gpa/io/scene_file.hpp"
 #include "gpa/io/study.hpp"
+#include "support/scenes.hpp"
 
 namespace gpa {
 namespace {
@@ -44,18 +46,7 @@ Shape run(const std::string& file, double refine) { return run(scene_file(file, 
 // The quarter of a 3D bar standing on the anvil z = 0 with its axis on z: the symmetry planes x = 0
 // and y = 0 cut it, and their ghosts continue it (docs/validation.md, "Half and quarter models": the
 // quarter is the whole bar's quadrant to round-off).
-Scene quarter_of(Scene s) {
-    for (int axis : {0, 1}) {
-        PlaneSpec p;
-        p.name = axis == 0 ? "x-symmetry" : "y-symmetry";
-        p.kind = PlaneKind::Symmetry;
-        p.axis = axis;
-        p.position = 0.0;
-        p.side = +1;
-        s.planes.push_back(p);
-    }
-    return s;
-}
+Scene quarter_of(Scene s) { return testing::with_quarter_planes(std::move(s)); }
 
 // The 2D scene with the solver of its 3D version: the hourglass damping on every node, the 3D
 // default (solver.hourglass_nodes), so that the comparison measures the 3D discretisation alone.

@@ -115,6 +115,18 @@ Scene short_copper_bar(GeometryKind geometry, int radial_cells) {
     return s;
 }
 
+Scene with_quarter_planes(Scene scene) {
+    for (int axis : {0, 1}) {
+        PlaneSpec p;
+        p.name = axis == 0 ? "x = 0" : "y = 0";
+        p.kind = PlaneKind::Symmetry;
+        p.axis = axis;
+        p.side = +1;
+        scene.planes.push_back(p);
+    }
+    return scene;
+}
+
 Scene armco_cylinder(int radial_cells, double end_time) {
     Scene s;
     s.name = "Armco iron cylinder impact";

@@ -36,6 +36,10 @@ std::string scene_file_refusal(const std::string& text, const std::filesystem::p
 // strain, its section: a strip 2R wide. The run tests of symmetry planes and orientation use it.
 Scene short_copper_bar(GeometryKind geometry, int radial_cells);
 
+// `scene` with the symmetry planes x = 0 and y = 0 (bodies on their positive sides): a quarter model
+// of a body whose axis is the z axis.
+Scene with_quarter_planes(Scene scene);
+
 // The paper's Armco-iron cylinder (L0 15.2 mm, D0 10.2 mm, 305 m/s) at `radial_cells` across
 // the radius, nodal viscosity, no lift-off, with the given end time.
 Scene armco_cylinder(int radial_cells, double end_time);
