@@ -91,8 +91,8 @@ CompressedRows find_neighbours(const NodeStore& nodes, double influence_distance
 
 // The pairs of the moment from candidate lists, in the candidates' order: of row i, the first
 // lattice_entries[i] entries (a fixed centre's lattice neighbours and their mirrors, of either
-// mode; lattice_entries empty: no row has any) while both nodes are fixed, and every j with r_ij < 2 h_ij that is not a pair of two fixed
-// nodes of one body (spec section 2). Nodes may switch between the search and the cut.
+// mode; lattice_entries empty: no row has any) while both nodes are fixed, and every j with
+// r_ij < 2 h_ij that is not a pair of two fixed nodes of one body (spec section 2). Nodes may switch between the search and the cut.
 // Deterministic and independent of the thread count.
 void filter_candidates(const NodeStore& nodes, double influence_distance, const CompressedRows& candidates,
                        const std::vector<std::uint32_t>& lattice_entries, CompressedRows& out,

@@ -51,8 +51,8 @@ public:
     // stiffness never calls it and carries nothing.
     void carry_reference_positions();
     bool carries_reference_positions() const { return carries_reference_; }
-    // Frees the lattice lists when no row has an entry (fixed_neighbours below): after the set-up,
-    // and when nodes have switched.
+    // Frees the lattice lists when no row has an entry (fixed_neighbours below); the set-up calls it
+    // once the lattices are prepared.
     void release_empty_lattice_rows();
 
     // --- state carried from step to step -------------------------------------------------
@@ -110,9 +110,9 @@ public:
     std::array<std::vector<double>, 3> force;              // N (a ring's force in axisymmetric)
 
     // Lattice neighbours of each node for fixed connectivity (spec section 2). Either a row per
-    // node or no rows at all: while no node has lattice neighbours (a scene without fixed nodes,
-    // or once every one has switched) the lists hold nothing, not an offset per node, and every
-    // row reads as empty (CompressedRows::row_or_empty, the way to read them).
+    // node or no rows at all: in a scene where no node has lattice neighbours the lists hold
+    // nothing, not an offset per node, and every row reads as empty (CompressedRows::row_or_empty,
+    // the way to read them). Rows kept at the set-up stay, empty or not, when nodes switch.
     CompressedRows fixed_neighbours;
     // Lattice neighbours that lie across a symmetry or rigid plane: the ghost image of node
     // fixed_mirrors.indices[k] across the planes in bit mask fixed_mirror_planes[k] (spec section 7:
