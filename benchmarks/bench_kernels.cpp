@@ -210,19 +210,21 @@ void point_update(benchmark::State& state, std::string material) {
     const PointProblem p = point_problem(m);
     const materials::PointModel model(m);
     std::vector<materials::PointState> work = p.states;
-    std::size_t returns = 0;
+    std::size_t returns = 0, evaluations = 0;
     for (auto _ : state) {
         work = p.states;
-        returns = 0;
+        returns = evaluations = 0;
         for (std::size_t k = 0; k < work.size(); ++k) {
             const auto r = model.update(work[k], p.increments[k]);
             returns += r.return_iterations > 0;
+            evaluations += static_cast<std::size_t>(r.return_iterations);
         }
         benchmark::DoNotOptimize(work.data());
     }
     state.counters["point_updates_per_s"] =
         benchmark::Counter(double(work.size()) * double(state.iterations()), benchmark::Counter::kIsRate);
     state.counters["plastic_fraction"] = double(returns) / double(work.size());
+    state.counters["evaluations_per_return"] = returns ? double(evaluations) / double(returns) : 0.0;
 }
 
 }  // namespace
