@@ -111,7 +111,11 @@ PointResult update_with(const PointModel& model, PointState& state, const PointI
     double plastic_power = 0.0;  // s_mid : d eps_p, J/m^3
     int return_iterations = 0;
     if (!state.failed) {
-        Eigen::Matrix3d trial = s_old + inc.dt * (2.0 * m.shear_modulus * d_dev + omega * s_old - s_old * omega);
+        // Omega s - s Omega = X + X^T with X = Omega s: Omega is antisymmetric and s symmetric bit
+        // for bit (both made so above and in to_matrix), so s Omega = -X^T bit for bit and one
+        // product serves (the same numbers as the two products).
+        const Eigen::Matrix3d spin = omega * s_old;
+        Eigen::Matrix3d trial = s_old + inc.dt * (2.0 * m.shear_modulus * d_dev + spin + spin.transpose());
         trial = (0.5 * (trial + trial.transpose())).eval();  // eval: no aliasing with transpose
         trial -= (trial.trace() / 3.0) * identity;
         const detail::ReturnResult r =
