@@ -1,6 +1,7 @@
 // Strength models and the radial return (materials.md, "Strength"; gpa-method.md section 4).
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -102,18 +103,64 @@ ReturnResult project(const Eigen::Matrix3d& trial, double trial_equivalent, doub
 // a return that reaches the cap is a fault of the point update (PointFault::return_not_converged),
 // which stops the run: it is never used silently.
 ReturnResult johnson_cook_return(const JohnsonCookStrength& jc, const Eigen::Matrix3d& trial, double trial_equivalent,
-                                 double shear_modulus, double plastic_strain, double dt, bool molten, double thermal,
-                                 double initial_flow_stress, double start) {
+                                 double shear_modulus, double plastic_strain, double strain_power, double dt, bool molten,
+                                 double thermal, double initial_flow_stress, double start) {
     const double three_g = 3.0 * shear_modulus;
-    const auto rate_of = [dt](double x) { return dt > 0.0 ? x / dt : 0.0; };
-    // Y and dY/dx at x (johnson_cook_flow): the strain slope plus the rate term's d/dx of
-    // C ln(x / (dt epsdot0)). The thermal factor does not change within the return, so it is taken
-    // once (by the caller); the rate factor once per evaluation, for Y and for its slope.
-    const auto flow = [&](double x) {
-        if (molten) return FlowStress{0.0, 0.0};
-        const double rate = johnson_cook_rate(jc, rate_of(x));
-        FlowStress y = johnson_cook_hardening(jc, plastic_strain + x, rate, thermal);
-        if (x > 0.0 && rate_of(x) > jc.reference_strain_rate) y.slope += y.stress / rate * jc.c / x;
+    // x -> epsdot / epsdot0 = x / (dt epsdot0) as one product: the rate ratio of every evaluation.
+    const double ratio_per_increment = dt > 0.0 ? 1.0 / (dt * jc.reference_strain_rate) : 0.0;
+    const double bn = jc.n > 0.0 ? jc.b * jc.n : 0.0;
+    // e^n = eps_p^n (1 + u)^n, u = x / eps_p, by the binomial series where u <= 2^-7, nested as
+    //   (1 + u)^n = 1 + f_1 u (1 + f_2 u (1 + ... (1 + f_8 u))),  f_k = (n - k + 1) / k:
+    // the terms to u^8 leave out at most |C(n, 9)| u^9 < 0.014 x 2^-63 = 1.5e-21 (0 < n <= 4), far
+    // below a double's round-off, for eight products and sums where std::pow takes about as long
+    // as the rest of an evaluation. At first yield (eps_p = 0), for larger u or n: std::pow.
+    const bool series = strain_power > 0.0 && jc.n <= 4.0;
+    const double inverse_strain = series ? 1.0 / plastic_strain : 0.0;
+    static constexpr std::array<double, 9> inverse_k{0.0, 1.0, 1.0 / 2, 1.0 / 3, 1.0 / 4, 1.0 / 5, 1.0 / 6, 1.0 / 7, 1.0 / 8};
+    std::array<double, 9> ratio_k{};  // f_k, independent of each other (no chain of divisions)
+    for (int k = 1; k < 9; ++k) ratio_k[k] = (jc.n - (k - 1)) * inverse_k[k];
+    // One evaluation at x > 0: Y(eps_p + x, x / dt) (johnson_cook_flow, the thermal factor taken
+    // once by the caller) and the Newton step's fraction. With e = eps_p + x, H = A + B e^n and
+    // the rate factor R = 1 + C ln(x / (dt epsdot0)) (1 below epsdot0),
+    //   dY/dx = T (R B n e^n / e + H C / x)      (the second term only above epsdot0),
+    // and the step in x of the iteration below, f / (x (3 G + dY/dx)), is f e / denominator with
+    //   denominator = 3 G e x + T (R B n e^n x + H C e):
+    // one division per evaluation, all its terms positive. Molten: Y = 0, the step f / (3 G x).
+    struct Evaluation {
+        double stress = 0.0;  // Y, Pa
+        double e = 1.0;       // the step is f * e / denominator
+        double denominator = 0.0;
+    };
+    const auto evaluate = [&](double x) {
+        Evaluation y;
+        if (molten) {
+            y.denominator = three_g * x;
+            return y;
+        }
+        const double ratio = x * ratio_per_increment;
+        const bool rate_hardens = ratio > 1.0;
+        const double rate = rate_hardens ? 1.0 + jc.c * std::log(ratio) : 1.0;
+        const double e = plastic_strain + x;
+        double hardening = jc.a;
+        double bn_en = 0.0;  // B n e^n
+        if (jc.b != 0.0 && jc.n > 0.0) {
+            const double u = x * inverse_strain;
+            double e_n;
+            if (series && u <= 0x1p-7) {
+                double nested = 1.0;
+                for (int k = 8; k >= 1; --k) nested = 1.0 + ratio_k[k] * u * nested;
+                e_n = strain_power * nested;
+            } else {
+                e_n = std::pow(e, jc.n);
+            }
+            hardening += jc.b * e_n;
+            bn_en = bn * e_n;
+        } else if (jc.b != 0.0) {
+            hardening += jc.b;  // n = 0 (validate() only allows it with B = 0)
+        }
+        y.stress = hardening * rate * thermal;
+        y.e = e;
+        y.denominator = three_g * e * x + thermal * (rate * bn_en * x + (rate_hardens ? hardening * jc.c * e : 0.0));
         return y;
     };
     double lo = 0.0;
@@ -121,7 +168,7 @@ ReturnResult johnson_cook_return(const JohnsonCookStrength& jc, const Eigen::Mat
     // The warm start: the last step's rate carried over, where it lies inside the bracket.
     double x = (start > 0.0 && start < hi) ? start : hi;
     const double tolerance = 1e-13 * trial_equivalent;
-    FlowStress y = flow(x);
+    Evaluation y = evaluate(x);
     int evaluations = 1;
     bool converged = false;
     for (int iteration = 0; iteration < johnson_cook_max_iterations; ++iteration) {
@@ -139,10 +186,10 @@ ReturnResult johnson_cook_return(const JohnsonCookStrength& jc, const Eigen::Mat
             converged = true;
             break;
         }
-        const double step = f / (x * (three_g + y.slope));  // f' = -(3 G + dY/dx); x > 0 here
+        const double step = f * y.e / y.denominator;  // f / (x (3 G + dY/dx)), f' = -(3 G + dY/dx); x > 0 here
         const double newton = step > -0.5 ? x * (1.0 + step) : x * std::exp(step);
         x = (newton > lo && newton < hi) ? newton : 0.5 * (lo + hi);
-        y = flow(x);
+        y = evaluate(x);
         ++evaluations;
     }
     ReturnResult r = project(trial, trial_equivalent, y.stress, x);
@@ -197,8 +244,15 @@ ReturnResult model_return(const JohnsonCookStrength& jc, const Eigen::Matrix3d& 
     const double trial_equivalent = von_mises(trial);
     const bool molten = t_star >= 1.0;
     const double thermal = molten ? 0.0 : johnson_cook_thermal(jc, t_star);
-    // No plastic flow yet: no rate term (its factor is 1).
-    const double y0 = molten ? 0.0 : johnson_cook_hardening(jc, plastic_strain, 1.0, thermal).stress;
+    // No plastic flow yet: no rate term (its factor is 1). eps_p^n, kept for the return's series.
+    const double strain_power = jc.b != 0.0 && jc.n > 0.0 && plastic_strain > 0.0 ? std::pow(plastic_strain, jc.n) : 0.0;
+    double hardening = jc.a;
+    if (jc.b != 0.0 && jc.n > 0.0) {
+        hardening += jc.b * strain_power;
+    } else if (jc.b != 0.0 && plastic_strain > 0.0) {
+        hardening += jc.b;  // n = 0 (johnson_cook_hardening)
+    }
+    const double y0 = molten ? 0.0 : hardening * thermal;
     elastic.flow_stress = y0;
     if (!(trial_equivalent > y0)) {
         return elastic;
@@ -206,8 +260,8 @@ ReturnResult model_return(const JohnsonCookStrength& jc, const Eigen::Matrix3d& 
     if (!(shear_modulus > 0.0)) {
         return project(trial, trial_equivalent, y0, 0.0);
     }
-    return johnson_cook_return(jc, trial, trial_equivalent, shear_modulus, plastic_strain, dt, molten, thermal, y0,
-                               previous_rate * dt);
+    return johnson_cook_return(jc, trial, trial_equivalent, shear_modulus, plastic_strain, strain_power, dt, molten,
+                               thermal, y0, previous_rate * dt);
 }
 
 }  // namespace detail

@@ -147,62 +147,96 @@ std::vector<JcCase> jc_cases() {
             {"convex n=1.5", {200e6, 900e6, 1.5, 0.02, 1.0, 1.0}, 40e9}};
 }
 
+// One step of a Johnson-Cook point, checked against the closed form: a plastic step lands on
+// Y(eps_p + d eps_p, d eps_p / dt) and satisfies the consistency condition, an elastic one makes
+// no plastic strain. Returns d eps_p (0 when elastic); counts the plastic and rate-hardened steps.
+struct JcStepCounts {
+    int plastic = 0;
+    int rate_hardened = 0;  // plastic steps with d eps_p / dt > epsdot0: the rate term is active
+};
+
+double expect_consistent_jc_step(const JcCase& c, Driver& p, const Eigen::Matrix3d& l, double dt, JcStepCounts& counts) {
+    const Material& m = p.material;
+    const Eigen::Matrix3d trial = jaumann_trial(to_matrix(p.state.deviatoric_stress), l, m.shear_modulus, dt);
+    const double t_star = homologous_temperature(m, p.state.temperature);  // start-of-step T
+    const double eps_before = p.state.plastic_strain;
+    const PointResult r = p.step(l, dt);
+    const double eps_after = p.state.plastic_strain;
+    const double sigma_trial = von_mises(trial);
+    const double d_eps = eps_after - eps_before;
+    // The elastic check: the flow stress with no plastic flow yet, i.e. at zero plastic rate
+    // (rate term floored at 1).
+    const double y_static = jc_closed_form(c.jc, eps_before, 0.0, t_star);
+    if (sigma_trial > y_static * (1.0 + 1e-12)) {
+        ++counts.plastic;
+        EXPECT_GT(d_eps, 0.0) << c.name;
+        // The reported rate is d eps_p / dt (to the rounding of reading d eps_p back).
+        EXPECT_NEAR(r.plastic_strain_rate * dt, d_eps, test::increment_read_back_tolerance(eps_after)) << c.name;
+        if (r.plastic_strain_rate > c.jc.reference_strain_rate) ++counts.rate_hardened;
+        // The return evaluates Y at exactly (eps_p + d eps_p, d eps_p / dt): the stored plastic
+        // strain and the reported rate are those two floating-point values, so the closed form
+        // there agrees with the returned deviator to round-off.
+        const double y_end = jc_closed_form(c.jc, eps_after, r.plastic_strain_rate, t_star);
+        EXPECT_NEAR(von_mises(p.state.deviatoric_stress), y_end, kStrengthRoundOff * y_end) << c.name;
+        // Consistency of the increment: sigma* - 3 G d eps_p = Y(eps_p + d eps_p, d eps_p / dt).
+        // The return stops at |residual| <= 1e-13 sigma*; the test's sigma* (the trial without
+        // the library's symmetrisation) differs by round-off; and the read-back d eps_p by at
+        // most the read-back bound, times 3 G. f falls with slope >= 3 G, so this residual also
+        // pins d eps_p to the root within kStrengthRoundOff sigma* / (3 G).
+        EXPECT_NEAR(sigma_trial - 3.0 * m.shear_modulus * d_eps, y_end,
+                    kStrengthRoundOff * sigma_trial + 3.0 * m.shear_modulus * test::increment_read_back_tolerance(eps_after))
+            << c.name;
+    } else {
+        EXPECT_EQ(d_eps, 0.0) << c.name;
+        EXPECT_EQ(r.plastic_strain_rate, 0.0) << c.name;
+    }
+    EXPECT_NEAR(test::trace(p.state.deviatoric_stress), 0.0, 1e-14 * std::max(sigma_trial, 1.0));
+    return d_eps;
+}
+
+Material jc_material(const JcCase& c) {
+    Material m = test::copper_linear();
+    m.shear_modulus = c.shear_modulus;
+    m.strength = c.jc;
+    m.specific_heat = 400.0;  // temperature rises, so T* varies from step to step
+    return m;
+}
+
 TEST(RadialReturn, JohnsonCookWithHardeningLandsOnTheYieldSurface) {
     // The rate of the Johnson-Cook strength is the equivalent plastic strain rate of the step,
     // d eps_p / dt, solved with the return: sigma* - 3 G d eps_p = Y(eps_p + d eps_p, d eps_p / dt, T*).
     for (const JcCase& c : jc_cases()) {
-        Material m = test::copper_linear();
-        m.shear_modulus = c.shear_modulus;
-        m.strength = c.jc;
-        m.specific_heat = 400.0;  // temperature rises, so T* varies from step to step
-        Driver p(m);
+        Driver p(jc_material(c));
         std::mt19937 rng(11);
-        int plastic_steps = 0;
-        int rate_hardened_steps = 0;  // plastic steps with d eps_p / dt > epsdot0: the rate term is active
-        for (int step = 0; step < 60; ++step) {
-            const Eigen::Matrix3d l = random_gradient(rng, 2e4);
-            const double dt = 1e-6;
-            const Eigen::Matrix3d trial = jaumann_trial(to_matrix(p.state.deviatoric_stress), l, m.shear_modulus, dt);
-            const double t_star = homologous_temperature(m, p.state.temperature);  // start-of-step T
-            const double eps_before = p.state.plastic_strain;
-            const PointResult r = p.step(l, dt);
-            const double eps_after = p.state.plastic_strain;
-            const double sigma_trial = von_mises(trial);
-            const double d_eps = eps_after - eps_before;
-            // The elastic check: the flow stress with no plastic flow yet, i.e. at zero plastic rate
-            // (rate term floored at 1).
-            const double y_static = jc_closed_form(c.jc, eps_before, 0.0, t_star);
-            if (sigma_trial > y_static * (1.0 + 1e-12)) {
-                ++plastic_steps;
-                EXPECT_GT(d_eps, 0.0) << c.name;
-                // The reported rate is d eps_p / dt (to the rounding of reading d eps_p back).
-                EXPECT_NEAR(r.plastic_strain_rate * dt, d_eps, test::increment_read_back_tolerance(eps_after))
-                    << c.name;
-                if (r.plastic_strain_rate > c.jc.reference_strain_rate) {
-                    ++rate_hardened_steps;
-                }
-                // The return evaluates Y at exactly (eps_p + d eps_p, d eps_p / dt): the stored plastic
-                // strain and the reported rate are those two floating-point values, so the closed form
-                // there agrees with the returned deviator to round-off.
-                const double y_end = jc_closed_form(c.jc, eps_after, r.plastic_strain_rate, t_star);
-                EXPECT_NEAR(von_mises(p.state.deviatoric_stress), y_end, kStrengthRoundOff * y_end) << c.name;
-                // Consistency of the increment: sigma* - 3 G d eps_p = Y(eps_p + d eps_p, d eps_p / dt).
-                // The return stops at |residual| <= 1e-13 sigma*; the test's sigma* (the trial without
-                // the library's symmetrisation) differs by round-off; and the read-back d eps_p by at
-                // most the read-back bound, times 3 G. f falls with slope >= 3 G, so this residual also
-                // pins d eps_p to the root within kStrengthRoundOff sigma* / (3 G).
-                EXPECT_NEAR(sigma_trial - 3.0 * m.shear_modulus * d_eps, y_end,
-                            kStrengthRoundOff * sigma_trial +
-                                3.0 * m.shear_modulus * test::increment_read_back_tolerance(eps_after))
-                    << c.name;
-            } else {
-                EXPECT_EQ(d_eps, 0.0) << c.name;
-                EXPECT_EQ(r.plastic_strain_rate, 0.0) << c.name;
+        JcStepCounts counts;
+        for (int step = 0; step < 60; ++step) expect_consistent_jc_step(c, p, random_gradient(rng, 2e4), 1e-6, counts);
+        EXPECT_GT(counts.plastic, 30) << c.name;        // the test exercised the return
+        EXPECT_GT(counts.rate_hardened, 30) << c.name;  // ... with the rate term in play
+    }
+}
+
+TEST(RadialReturn, JohnsonCookStrainTermBySeriesAgreesWithTheClosedForm) {
+    // Where the step's plastic increment is small beside the plastic strain reached (u = d eps_p /
+    // eps_p <= 2^-7), the return takes (eps_p + x)^n as eps_p^n times the binomial series of
+    // (1 + x / eps_p)^n (strength.cpp); elsewhere std::pow. Short steps (20 ns) from plastic
+    // strains 0.02-2 take both sides of that line; every step must still land on the closed form
+    // (std::pow) to round-off and satisfy the consistency condition.
+    for (const JcCase& c : jc_cases()) {
+        std::mt19937 rng(5);
+        JcStepCounts counts;
+        int by_series = 0, by_pow = 0;
+        for (double start : {0.02, 0.2, 2.0}) {
+            Driver p(jc_material(c));
+            p.state.plastic_strain = start;
+            for (int step = 0; step < 40; ++step) {
+                const double eps_before = p.state.plastic_strain;
+                const double d_eps = expect_consistent_jc_step(c, p, random_gradient(rng, 5e5), 2e-8, counts);
+                if (d_eps > 0.0) ++(d_eps <= 0x1p-7 * eps_before ? by_series : by_pow);
             }
-            EXPECT_NEAR(test::trace(p.state.deviatoric_stress), 0.0, 1e-14 * std::max(sigma_trial, 1.0));
         }
-        EXPECT_GT(plastic_steps, 30) << c.name;         // the test exercised the return
-        EXPECT_GT(rate_hardened_steps, 30) << c.name;  // ... with the rate term in play
+        EXPECT_GT(by_series, 20) << c.name;  // both forms were exercised
+        EXPECT_GT(by_pow, 10) << c.name;
+        EXPECT_GT(counts.rate_hardened, 30) << c.name;
     }
 }
 
