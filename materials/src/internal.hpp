@@ -85,6 +85,7 @@ struct ReturnResult {
     double flow_stress = 0.0;              // Y at the end of the step (0 for an elastic material)
     bool plastic = false;
     int iterations = 0;  // Johnson-Cook: flow-stress evaluations of the return's iteration (0 otherwise)
+    double trial_equivalent = 0.0;  // sigma_eq of the trial deviator, where it was returned (plastic)
 };
 
 // Radial return of the trial deviator to the flow stress of the strength model at plastic strain

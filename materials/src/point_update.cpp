@@ -127,7 +127,7 @@ PointResult update_with(const PointModel& model, PointState& state, const PointI
         plastic_rate = inc.dt > 0.0 ? plastic_increment / inc.dt : 0.0;
         if (plastic_increment > 0.0) {
             const Eigen::Matrix3d s_mid = 0.5 * (s_old + s_new);
-            plastic_power = plastic_increment * 1.5 * s_mid.cwiseProduct(trial).sum() / detail::von_mises(trial);
+            plastic_power = plastic_increment * 1.5 * s_mid.cwiseProduct(trial).sum() / r.trial_equivalent;
         }
     }
 
@@ -137,7 +137,6 @@ PointResult update_with(const PointModel& model, PointState& state, const PointI
     const double rho_mid = 0.5 * (rho_old + rho_new);
     const double dv = 1.0 / rho_new - 1.0 / rho_old;
     const double q_mid = 0.5 * (inc.viscous_pressure_old + inc.viscous_pressure_new);
-    const double deviatoric_work = inc.dt / rho_mid * (0.5 * (s_old + s_new)).cwiseProduct(d_dev).sum();
 
     const detail::EosTerms eos = detail::model_terms(eos_model, m.density, rho_new);
     if (eos.beyond_limit) return fault(PointFault::eos_limit);
@@ -151,6 +150,7 @@ PointResult update_with(const PointModel& model, PointState& state, const PointI
         if (state.failed && pressure < 0.0) pressure = 0.0;
     } else {
         // e_new = known - (a + b e_new) dv / 2  =>  e_new (1 + b dv / 2) = known - a dv / 2.
+        const double deviatoric_work = inc.dt / rho_mid * (0.5 * (s_old + s_new)).cwiseProduct(d_dev).sum();
         const double known = state.specific_internal_energy + deviatoric_work - (0.5 * state.pressure + q_mid) * dv;
         const double denominator = energy_solve_denominator(eos.b, inc);
         // b = Gamma0 rho0 (Mie-Grueneisen), so 1 + b dv / 2 falls to 1/2 when one step shrinks the

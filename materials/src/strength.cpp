@@ -68,6 +68,7 @@ ReturnResult project(const Eigen::Matrix3d& trial, double trial_equivalent, doub
     r.plastic_strain_increment = plastic_increment;
     r.flow_stress = flow_stress;
     r.plastic = true;
+    r.trial_equivalent = trial_equivalent;
     return r;
 }
 
