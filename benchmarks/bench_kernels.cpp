@@ -156,8 +156,8 @@ void plan(benchmark::State& state, Problem problem, int threads, ScatterScheme s
 // them. A quarter of the points, unloaded to half their flow stress and strained at 10 1/s, stay
 // elastic (the README main job's returns are three quarters of its point updates). Each point is
 // first driven onto its yield surface (40 steps that strain it by 2e-4 each, then 3 of 20 ns);
-// every iteration then updates all points from that kept state (the copy is timed too, about 1 %
-// of it).
+// every iteration then updates all points from that kept state (the copy of the 10^4 states is
+// timed too).
 struct PointProblem {
     std::vector<materials::PointState> states;
     std::vector<materials::PointIncrement> increments;

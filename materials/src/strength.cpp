@@ -24,20 +24,26 @@ double johnson_cook_rate(const JohnsonCookStrength& jc, double strain_rate) {
     return rate_ratio > 1.0 ? 1.0 + jc.c * std::log(rate_ratio) : 1.0;
 }
 
+// eps_p^n of the strain term, 0 where it has none (B = 0, n = 0) or at eps_p <= 0.
+double strain_power_of(const JohnsonCookStrength& jc, double plastic_strain) {
+    return jc.b != 0.0 && jc.n > 0.0 && plastic_strain > 0.0 ? std::pow(plastic_strain, jc.n) : 0.0;
+}
+
+// The strain term A + B eps_p^n from eps_p^n (strain_power_of, or the return's series). n = 0: a
+// step at eps_p = 0 (validate() only allows it with B = 0).
+double strain_hardening(const JohnsonCookStrength& jc, double plastic_strain, double strain_power) {
+    if (jc.b != 0.0 && jc.n > 0.0) return jc.a + jc.b * strain_power;
+    return jc.b != 0.0 && plastic_strain > 0.0 ? jc.a + jc.b : jc.a;
+}
+
 // Y and dY/d eps_p from the strain term and the two factors above.
 FlowStress johnson_cook_hardening(const JohnsonCookStrength& jc, double plastic_strain, double rate, double thermal) {
-    double hardening = jc.a;
+    const double eps_n = strain_power_of(jc, plastic_strain);
+    const double hardening = strain_hardening(jc, plastic_strain, eps_n);
     double slope = 0.0;
     if (jc.b != 0.0 && jc.n > 0.0) {
-        if (plastic_strain > 0.0) {
-            const double eps_n = std::pow(plastic_strain, jc.n);
-            hardening += jc.b * eps_n;
-            slope = jc.b * jc.n * eps_n / plastic_strain;
-        } else {
-            slope = jc.n < 1.0 ? std::numeric_limits<double>::infinity() : (jc.n == 1.0 ? jc.b : 0.0);
-        }
-    } else if (jc.b != 0.0 && plastic_strain > 0.0) {
-        hardening += jc.b;  // n = 0: a step at eps_p = 0 (validate() only allows it with B = 0)
+        slope = plastic_strain > 0.0 ? jc.b * jc.n * eps_n / plastic_strain
+                                     : (jc.n < 1.0 ? std::numeric_limits<double>::infinity() : (jc.n == 1.0 ? jc.b : 0.0));
     }
     return {hardening * rate * thermal, slope * rate * thermal};
 }
@@ -119,19 +125,22 @@ ReturnResult johnson_cook_return(const JohnsonCookStrength& jc, const Eigen::Mat
     // (eps_p = 0), for larger u or n: std::pow.
     const bool series = strain_power > 0.0 && jc.n <= 4.0;
     const double inverse_strain = series ? 1.0 / plastic_strain : 0.0;
-    static constexpr std::array<double, 9> inverse_k{0.0, 1.0, 1.0 / 2, 1.0 / 3, 1.0 / 4, 1.0 / 5, 1.0 / 6, 1.0 / 7, 1.0 / 8};
-    std::array<double, 9> ratio_k{};  // f_k, independent of each other (no chain of divisions)
-    for (int k = 1; k < 9; ++k) ratio_k[k] = (jc.n - (k - 1)) * inverse_k[k];
-    // C(n, k) = f_1 ... f_k, as a tree of products (short chains).
+    // C(n, k) = f_1 ... f_k, the f_k independent of each other (no chain of divisions), their
+    // products as a tree (short chains); only where the series serves.
     std::array<double, 9> binomial{};
-    binomial[1] = ratio_k[1];
-    binomial[2] = ratio_k[1] * ratio_k[2];
-    binomial[3] = binomial[2] * ratio_k[3];
-    binomial[4] = binomial[2] * (ratio_k[3] * ratio_k[4]);
-    binomial[5] = binomial[4] * ratio_k[5];
-    binomial[6] = binomial[4] * (ratio_k[5] * ratio_k[6]);
-    binomial[7] = binomial[6] * ratio_k[7];
-    binomial[8] = binomial[4] * ((ratio_k[5] * ratio_k[6]) * (ratio_k[7] * ratio_k[8]));
+    if (series) {
+        static constexpr std::array<double, 9> inverse_k{0.0, 1.0, 1.0 / 2, 1.0 / 3, 1.0 / 4, 1.0 / 5, 1.0 / 6, 1.0 / 7, 1.0 / 8};
+        std::array<double, 9> f{};
+        for (int k = 1; k < 9; ++k) f[k] = (jc.n - (k - 1)) * inverse_k[k];
+        binomial[1] = f[1];
+        binomial[2] = f[1] * f[2];
+        binomial[3] = binomial[2] * f[3];
+        binomial[4] = binomial[2] * (f[3] * f[4]);
+        binomial[5] = binomial[4] * f[5];
+        binomial[6] = binomial[4] * (f[5] * f[6]);
+        binomial[7] = binomial[6] * f[7];
+        binomial[8] = binomial[4] * ((f[5] * f[6]) * (f[7] * f[8]));
+    }
     // One evaluation at x > 0: Y(eps_p + x, x / dt) (johnson_cook_flow, the thermal factor taken
     // once by the caller) and the Newton step's fraction. With e = eps_p + x, H = A + B e^n and
     // the rate factor R = 1 + C ln(x / (dt epsdot0)) (1 below epsdot0),
@@ -154,11 +163,9 @@ ReturnResult johnson_cook_return(const JohnsonCookStrength& jc, const Eigen::Mat
         const bool rate_hardens = ratio > 1.0;
         const double rate = rate_hardens ? 1.0 + jc.c * std::log(ratio) : 1.0;
         const double e = plastic_strain + x;
-        double hardening = jc.a;
-        double bn_en = 0.0;  // B n e^n
+        double e_n = 0.0;  // e^n where the strain term has one
         if (jc.b != 0.0 && jc.n > 0.0) {
             const double u = x * inverse_strain;
-            double e_n;
             if (series && u <= 0x1p-7) {
                 const double u2 = u * u, u4 = u2 * u2;
                 const double low = (1.0 + binomial[1] * u) + u2 * (binomial[2] + binomial[3] * u);
@@ -167,11 +174,9 @@ ReturnResult johnson_cook_return(const JohnsonCookStrength& jc, const Eigen::Mat
             } else {
                 e_n = std::pow(e, jc.n);
             }
-            hardening += jc.b * e_n;
-            bn_en = bn * e_n;
-        } else if (jc.b != 0.0) {
-            hardening += jc.b;  // n = 0 (validate() only allows it with B = 0)
         }
+        const double hardening = strain_hardening(jc, e, e_n);
+        const double bn_en = bn * e_n;  // B n e^n
         y.stress = hardening * rate * thermal;
         y.e = e;
         y.denominator = three_g * e * x + thermal * (rate * bn_en * x + (rate_hardens ? hardening * jc.c * e : 0.0));
@@ -259,14 +264,8 @@ ReturnResult model_return(const JohnsonCookStrength& jc, const Eigen::Matrix3d& 
     const bool molten = t_star >= 1.0;
     const double thermal = molten ? 0.0 : johnson_cook_thermal(jc, t_star);
     // No plastic flow yet: no rate term (its factor is 1). eps_p^n, kept for the return's series.
-    const double strain_power = jc.b != 0.0 && jc.n > 0.0 && plastic_strain > 0.0 ? std::pow(plastic_strain, jc.n) : 0.0;
-    double hardening = jc.a;
-    if (jc.b != 0.0 && jc.n > 0.0) {
-        hardening += jc.b * strain_power;
-    } else if (jc.b != 0.0 && plastic_strain > 0.0) {
-        hardening += jc.b;  // n = 0 (johnson_cook_hardening)
-    }
-    const double y0 = molten ? 0.0 : hardening * thermal;
+    const double strain_power = strain_power_of(jc, plastic_strain);
+    const double y0 = molten ? 0.0 : strain_hardening(jc, plastic_strain, strain_power) * thermal;
     elastic.flow_stress = y0;
     if (!(trial_equivalent > y0)) {
         return elastic;
