@@ -11,11 +11,17 @@ namespace gpa {
 
 using NodeIndex = std::uint32_t;
 
-// v.resize(n), but growing past the capacity reserves 1/8 more instead of doubling: arrays
-// rebuilt every step (lists, ghost fields) then stay within 1/8 of what they need.
+// What an array grows by beyond what it needs when it grows past its capacity: 1/64. Arrays
+// rebuilt every step (lists, ghost fields, the node store with its ghosts) then stay within 1/64 of
+// what they need. Doubling (what resize() itself does) would double the memory of a run; an eighth
+// took 90 bytes of a 2D node's 975 at 10^6 nodes (docs/performance.md section 3), and a sixty-fourth
+// still grows a 10^6-node store about 16000 ghosts at a time.
+inline constexpr std::size_t growth_slack_divisor = 64;
+
+// v.resize(n), growing past the capacity by the slack above instead of doubling.
 template <class Vector>
 void resize_with_slack(Vector& v, std::size_t n) {
-    if (n > v.capacity()) v.reserve(n + n / 8);
+    if (n > v.capacity()) v.reserve(n + n / growth_slack_divisor);
     v.resize(n);
 }
 
@@ -26,7 +32,7 @@ template <class Vector>
 void resize_discarding(Vector& v, std::size_t n) {
     if (n > v.capacity()) {
         Vector().swap(v);
-        v.reserve(n + n / 8);
+        v.reserve(n + n / growth_slack_divisor);
     }
     v.resize(n);
 }
