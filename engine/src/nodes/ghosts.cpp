@@ -497,7 +497,7 @@ void GhostSet::append_ghost_rows(CompressedRows& lists, std::size_t real_count) 
         count[k + 1] += count[k];
         lists.offsets[real_count + k + 1] = base + count[k + 1];
     }
-    resize_with_slack(lists.indices, base + count[ghosts]);
+    resize_with_slack(lists.indices, base + count[ghosts], per_entry_slack);
     std::vector<std::size_t> next(ghosts);
     for (std::size_t k = 0; k < ghosts; ++k) next[k] = base + count[k];
     tbb::parallel_for(all_sources, [&](const tbb::blocked_range<std::size_t>& r) {

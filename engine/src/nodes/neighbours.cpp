@@ -418,7 +418,7 @@ void find_neighbours(const NodeStore& nodes, InfluenceDistance influence, std::s
     });
     for (std::size_t k = 0; k < rows; ++k) out.offsets[k + 1] += out.offsets[k];
     if (scratch.check_entries && only.empty()) scratch.check_entries(out.offsets[rows]);
-    resize_discarding(out.indices, out.offsets[rows]);
+    resize_discarding(out.indices, out.offsets[rows], per_entry_slack);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rows, search_block), [&](const tbb::blocked_range<std::size_t>& r) {
         for (std::size_t k = r.begin(); k != r.end(); ++k) {
             std::size_t next = out.offsets[k];
@@ -511,7 +511,7 @@ void filter_rows(const NodeStore& nodes, double a, const CompressedRows& candida
         }
     });
     for (std::size_t i = 0; i < rows; ++i) out.offsets[i + 1] += out.offsets[i];
-    resize_discarding(out.indices, out.offsets[rows]);
+    resize_discarding(out.indices, out.offsets[rows], per_entry_slack);
     // Pass 2: copy the kept entries in order, a set bit at a time (the lowest first), without a
     // branch on each candidate, which no predictor guesses (about a third of them go).
     const std::uint64_t* kept = keep.data();
@@ -537,7 +537,7 @@ void filter_candidates(const NodeStore& nodes, double a, const CompressedRows& c
     if (!lattice_entries.empty() && lattice_entries.size() < rows) {
         throw InputError(fmt::format("filter_candidates: {} lattice counts for {} rows", lattice_entries.size(), rows));
     }
-    resize_discarding(keep, rows + candidates.entries() / 64 + 1);  // first_keep_word's words
+    resize_discarding(keep, rows + candidates.entries() / 64 + 1, per_entry_slack);  // first_keep_word's words
     resize_discarding(out.offsets, rows + 1);
     out.offsets[0] = 0;
     if (nodes.dim() == 2) {

@@ -127,9 +127,9 @@ void NodeStore::resize(std::size_t count) {
     if (count > std::size_t{0xFFFFFFFFu}) {
         throw InputError(fmt::format("node count {} exceeds the limit of 2^32 - 1 nodes", count));
     }
-    // Growing past the capacity reserves 1/64 more than asked (resize_with_slack), not the
-    // doubling that resize() itself would do: the ghosts come and go every step, and doubled
-    // fields would double the memory of a run.
+    // Growing past the capacity reserves 1/64 more than asked (resize_with_slack, per_node_slack),
+    // not the doubling that resize() itself would do: the ghosts come and go every step, and
+    // doubled fields would double the memory of a run.
     for_each_field([count](std::string_view, auto& field) { resize_with_slack(field, count); });
     resize_rows(fixed_neighbours, nullptr, count);
     resize_rows(fixed_mirrors, &fixed_mirror_planes, count);

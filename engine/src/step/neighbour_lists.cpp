@@ -77,7 +77,7 @@ double* NeighbourLists::keep_pairs(std::size_t real) {
     }
     const std::size_t entries = lists_.offsets[std::min(real, lists_.rows())];
     if (entries > kept_weight_over_r2_.capacity()) kept_weight_over_r2_.clear();  // grown: no copy of the old terms beside the new array
-    resize_with_slack(kept_weight_over_r2_, entries);
+    resize_with_slack(kept_weight_over_r2_, entries, per_entry_slack);
     return kept_weight_over_r2_.data();
 }
 
@@ -408,7 +408,7 @@ void NeighbourLists::search_rows(NodeStore& nodes, std::size_t real, GhostSet& g
     if (scratch_.check_entries) scratch_.check_entries(new_entries);
     // In place, from the last row back: each stretch of rows between two that gain entries moves
     // up by the entries gained before its end, then the row before it takes its additions.
-    resize_with_slack(candidates_.indices, new_entries);
+    resize_with_slack(candidates_.indices, new_entries, per_entry_slack);
     NodeIndex* index = candidates_.indices.data();
     std::size_t end_old = old_entries, shift = total_added;
     for (std::size_t c = changed.size(); c-- > 0;) {

@@ -11,17 +11,23 @@ namespace gpa {
 
 using NodeIndex = std::uint32_t;
 
-// What an array grows by beyond what it needs when it grows past its capacity: 1/64. Arrays
-// rebuilt every step (lists, ghost fields, the node store with its ghosts) then stay within 1/64 of
-// what they need. Doubling (what resize() itself does) would double the memory of a run; an eighth
-// took 90 bytes of a 2D node's 975 at 10^6 nodes (docs/performance.md section 3), and a sixty-fourth
-// still grows a 10^6-node store about 16000 ghosts at a time.
-inline constexpr std::size_t growth_slack_divisor = 64;
+// What an array grows by beyond what it needs when it grows past its capacity, as a divisor of
+// its new size. Doubling (what resize() itself does) would double the memory of a run.
+//   * Arrays per node (the node store with its ghosts, per-node sums, row offsets): 1/64. Their
+//     sizes move only with the ghosts, by little, and an eighth of them took 40 bytes of a 2D
+//     node at 10^6 nodes (docs/performance.md section 3).
+//   * Arrays per list entry (candidates, lists, kept pair terms): 1/8. Their sizes grow with the
+//     pairs at every search of a body being compressed, and each growth makes a new array whose
+//     pages the system hands out afresh; at 1/64 the 3D variable benchmark faulted in 110 MB more
+//     per run and its neighbours phase took 7 % longer, while the unused tail of an array is
+//     never touched and costs no resident memory.
+inline constexpr std::size_t per_node_slack = 64;
+inline constexpr std::size_t per_entry_slack = 8;
 
-// v.resize(n), growing past the capacity by the slack above instead of doubling.
+// v.resize(n), growing past the capacity by n / slack instead of doubling.
 template <class Vector>
-void resize_with_slack(Vector& v, std::size_t n) {
-    if (n > v.capacity()) v.reserve(n + n / growth_slack_divisor);
+void resize_with_slack(Vector& v, std::size_t n, std::size_t slack = per_node_slack) {
+    if (n > v.capacity()) v.reserve(n + n / slack);
     v.resize(n);
 }
 
@@ -29,10 +35,10 @@ void resize_with_slack(Vector& v, std::size_t n) {
 // before the new one is made, so that the two never take memory at once (a copy of the old lists
 // beside the new ones was the peak of a search: 3D, 10^6 nodes, 2967 against 2507 bytes per node).
 template <class Vector>
-void resize_discarding(Vector& v, std::size_t n) {
+void resize_discarding(Vector& v, std::size_t n, std::size_t slack = per_node_slack) {
     if (n > v.capacity()) {
         Vector().swap(v);
-        v.reserve(n + n / growth_slack_divisor);
+        v.reserve(n + n / slack);
     }
     v.resize(n);
 }
