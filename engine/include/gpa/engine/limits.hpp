@@ -34,9 +34,9 @@ double bytes_per_node_besides_lists(int dim);
 // lists (4).
 constexpr double bytes_per_list_entry = 8.125;
 // And per list entry the term a step keeps for its sweeps (R_ij / r_ij^2, 8 bytes, with the 1/8 the
-// array grows by beyond what it needs, per_entry_slack; NeighbourLists::keep_pairs). A run whose lists fit the
-// memory limit without them, but not with them, goes without them: its forces, energy booking and
-// smoothing then make those terms again, slower, to the same numbers.
+// array grows by beyond what it needs, per_entry_slack; NeighbourLists::keep_pairs). A run whose
+// lists fit the memory limit without them, but not with them, goes without them: its forces,
+// energy booking and smoothing then make those terms again, slower, to the same numbers.
 constexpr double bytes_per_kept_pair = 9.0;
 // Candidate pairs per node at the start of a run (skin 0.25, influence distance 1): about 21 in
 // 2D and 56 in 3D (docs/performance.md section 3).
