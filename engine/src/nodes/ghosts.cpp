@@ -13,6 +13,7 @@
 
 #include "gpa/engine/errors.hpp"
 #include "gpa/engine/state_io.hpp"
+#include "reduce_grain.hpp"
 
 namespace gpa {
 
@@ -98,7 +99,7 @@ GhostSet::GhostSet(std::vector<GhostPlane> planes) : planes_(std::move(planes)) 
 
 void GhostSet::update_contacts(NodeStore& nodes, std::size_t real_count, bool initial) const {
     if (lift_off_mask_ == 0) return;
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, real_count, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, real_count, costly_node_grain), [&](const tbb::blocked_range<std::size_t>& r) {
         for (std::size_t i = r.begin(); i != r.end(); ++i) {
             std::uint8_t bits = nodes.plane_contact[i];
             for (std::size_t p = 0; p < planes_.size(); ++p) {
@@ -233,7 +234,7 @@ void GhostSet::update(NodeStore& nodes, std::size_t real_count) const {
     }
     // Field by field, each copied in a loop of its own (copy_to_ghosts): one loop over every field
     // would load each field's address again after every byte it stores (a byte may alias anything).
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, ghosts, 2048), [&](const tbb::blocked_range<std::size_t>& r) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, ghosts, ghost_grain), [&](const tbb::blocked_range<std::size_t>& r) {
         mirror_to_ghosts(vector_field(nodes.position), dim, real_count, r.begin(), r.end(), Mirrored::Point);
         mirror_to_ghosts(vector_field(nodes.velocity), dim, real_count, r.begin(), r.end(), Mirrored::Vector);
         mirror_to_ghosts(vector_field(nodes.initial_position), dim, real_count, r.begin(), r.end(), Mirrored::Point);
@@ -256,7 +257,7 @@ void GhostSet::update(NodeStore& nodes, std::size_t real_count) const {
 }
 
 void GhostSet::mirror_vector_field(const std::array<double*, 3>& field, int dim, std::size_t real_count) const {
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, source_.size(), 2048), [&](const tbb::blocked_range<std::size_t>& r) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, source_.size(), ghost_grain), [&](const tbb::blocked_range<std::size_t>& r) {
         mirror_to_ghosts(field, dim, real_count, r.begin(), r.end(), Mirrored::Vector);
     });
 }
@@ -285,7 +286,7 @@ void GhostSet::mirror_to_ghosts(const std::array<double*, 3>& field, int dim, st
 GhostReach GhostSet::pair_reach(const NodeStore& nodes, std::size_t real_count, double influence_distance, double margin) const {
     const double a = influence_distance;
     const double deepest = tbb::parallel_reduce(
-        tbb::blocked_range<std::size_t>(0, real_count, 4096), -std::numeric_limits<double>::infinity(),
+        tbb::blocked_range<std::size_t>(0, real_count, costly_node_grain), -std::numeric_limits<double>::infinity(),
         [&](const tbb::blocked_range<std::size_t>& r, double acc) {
             for (std::size_t i = r.begin(); i != r.end(); ++i) {
                 for (const GhostPlane& p : planes_) acc = std::max(acc, a * nodes.diameter[i] - p.distance_of(nodes.position, i));
@@ -305,7 +306,7 @@ bool GhostSet::covers(const NodeStore& nodes, std::size_t real_count, GhostReach
         const auto& index = index_[slot];
         if (index.size() != real_count) return false;
         const bool missing = tbb::parallel_reduce(
-            tbb::blocked_range<std::size_t>(0, real_count, 4096), false,
+            tbb::blocked_range<std::size_t>(0, real_count, costly_node_grain), false,
             [&](const tbb::blocked_range<std::size_t>& r, bool found) {
                 for (std::size_t i = r.begin(); i != r.end() && !found; ++i) {
                     if (index[i] >= 0 || !selectable(nodes, i, m)) continue;
@@ -382,7 +383,7 @@ void GhostSet::refresh(NodeStore& nodes, std::size_t real_count) const {
     for (int c = 0; c < comps; ++c) stress[c] = nodes.deviatoric_stress[c].data();
     for (int c = 0; c < dim; ++c) normalisation[c] = nodes.alpha[c].data();
     for (int c = 0; c < shears; ++c) normalisation[first_shear + c] = nodes.alpha_shear[c].data();
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, source_.size(), 2048), [&](const tbb::blocked_range<std::size_t>& r) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, source_.size(), ghost_grain), [&](const tbb::blocked_range<std::size_t>& r) {
         // Field by field, as in update().
         mirror_tensors_to_ghosts(stress, comps, dim, real_count, r.begin(), r.end());
         mirror_tensors_to_ghosts(normalisation, first_shear + shears, dim, real_count, r.begin(), r.end());

@@ -77,7 +77,7 @@ void EnergyLedger::compatible_powers(const CompressedRows& lists, WeightKind wei
     // energy within 0.4 us of a 4 km/s impact at C_cfl 0.4, +1.5 % at 0.2.)
     constexpr int D = G::dim;
     for (int c = 0; c < D; ++c) resize_with_slack(mean_velocity_[c], nodes.size());
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, real, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, real, costly_node_grain), [&](const tbb::blocked_range<std::size_t>& r) {
         for (int c = 0; c < D; ++c) {
             const double* v = nodes.velocity[c].data();
             const double* f = nodes.force[c].data();

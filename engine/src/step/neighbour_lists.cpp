@@ -155,7 +155,7 @@ NeighbourLists::Staleness NeighbourLists::staleness(const NodeStore& nodes, std:
             double growth = 0.0;
         };
         const Extent e = tbb::parallel_reduce(
-            tbb::blocked_range<std::size_t>(0, real, reduce_grain), Extent{},
+            tbb::blocked_range<std::size_t>(0, real, costly_node_grain), Extent{},
             [&](const tbb::blocked_range<std::size_t>& r, Extent acc) {
                 for (std::size_t i = r.begin(); i != r.end(); ++i) {
                     for (int c = 0; c < d; ++c) {
@@ -178,7 +178,7 @@ NeighbourLists::Staleness NeighbourLists::staleness(const NodeStore& nodes, std:
         std::array<double, 3> middle{0, 0, 0};
         for (int c = 0; c < d; ++c) middle[c] = 0.5 * (e.lo[c] + e.hi[c]);
         const double largest = tbb::parallel_reduce(
-            tbb::blocked_range<std::size_t>(0, real, reduce_grain), 0.0,
+            tbb::blocked_range<std::size_t>(0, real, costly_node_grain), 0.0,
             [&](const tbb::blocked_range<std::size_t>& r, double acc) {
                 for (std::size_t i = r.begin(); i != r.end(); ++i) {
                     double u2 = 0.0;
@@ -200,7 +200,7 @@ NeighbourLists::Staleness NeighbourLists::staleness(const NodeStore& nodes, std:
     // The per-row budget (the header): |u_i| + a |d_i - d_then,i|, each row from its own search;
     // NaN with a NaN position or diameter (place_ghosts then searches in full).
     out.largest_budget = tbb::parallel_reduce(
-        tbb::blocked_range<std::size_t>(0, real, reduce_grain), 0.0,
+        tbb::blocked_range<std::size_t>(0, real, costly_node_grain), 0.0,
         [&](const tbb::blocked_range<std::size_t>& r, double acc) {
             for (std::size_t i = r.begin(); i != r.end(); ++i) {
                 const double budget = row_budget(nodes, i, a);
@@ -237,7 +237,7 @@ bool NeighbourLists::switched_near_quiet_rows(const NodeStore& nodes, std::size_
     // source, whose row has the mirror image of the pair).
     if (!any_quiet_) return false;
     return tbb::parallel_reduce(
-        tbb::blocked_range<std::size_t>(0, real, reduce_grain), false,
+        tbb::blocked_range<std::size_t>(0, real, costly_node_grain), false,
         [&](const tbb::blocked_range<std::size_t>& r, bool found) {
             for (std::size_t i = r.begin(); i != r.end() && !found; ++i) {
                 if (!searched_fixed_[i] || nodes.connectivity[i] == Connectivity::Fixed) continue;

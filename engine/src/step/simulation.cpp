@@ -263,7 +263,7 @@ void Simulation::Impl::geometry() {
     const NodeDiameter rule = scene.solver.node_diameter;
     const int diameter_rule = rule == NodeDiameter::Section ? 0 : rule == NodeDiameter::Volume ? 1 : rule == NodeDiameter::Hoop ? 2 : 3;
     const bool stretch = G::dim == 3 && rule == NodeDiameter::Stretch;
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, real, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, real, costly_node_grain), [&](const tbb::blocked_range<std::size_t>& r) {
         for (std::size_t i = r.begin(); i != r.end(); ++i) {
             double lambda = 1.0;
             if (stretch && !nodes.failed[i]) {  // a failed node is debris: its support follows its volume
@@ -338,7 +338,7 @@ void Simulation::Impl::time_step() {
     const double* closing_speed = contact.closing_speed();
     const double volume_limit = scene.solver.max_volume_change > 0.0 ? scene.solver.max_volume_change / scene.solver.cfl : 0.0;
     const double limit = tbb::parallel_reduce(
-        tbb::blocked_range<std::size_t>(0, real, reduce_grain), std::numeric_limits<double>::infinity(),
+        tbb::blocked_range<std::size_t>(0, real, costly_node_grain), std::numeric_limits<double>::infinity(),
         [&](const tbb::blocked_range<std::size_t>& r, double best) {
             for (std::size_t i = r.begin(); i != r.end(); ++i) {
                 const double q = std::max(nodes.viscous_pressure[i], largest_bond_q.empty() ? 0.0 : largest_bond_q[i]);
@@ -444,7 +444,7 @@ void Simulation::Impl::integrate(double dt_avg) {
     ledger.keep_half_step_velocities(nodes);
     if (external.forces_pending()) external.add_to_forces(nodes, real);  // a program's loads join the forces
     rigid_planes.apply_friction(ghosts, nodes, real, dt_avg);  // Coulomb friction joins the forces
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, real, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, real, costly_node_grain), [&](const tbb::blocked_range<std::size_t>& r) {
         for (int c = 0; c < d; ++c) {
             double* v = nodes.velocity[c].data();
             const double* f = nodes.force[c].data();
