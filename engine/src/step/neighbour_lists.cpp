@@ -204,7 +204,9 @@ NeighbourLists::Staleness NeighbourLists::staleness(const NodeStore& nodes, std:
         [&](const tbb::blocked_range<std::size_t>& r, double acc) {
             for (std::size_t i = r.begin(); i != r.end(); ++i) {
                 const double budget = row_budget(nodes, i, a);
-                if (!(budget <= acc)) acc = budget;  // a NaN stays (std::max would drop it)
+                // A NaN, once met, stays: std::max would drop it, and so would a test that lets a
+                // later finite budget replace it (as this one did, unless the NaN ended its task).
+                if (!std::isnan(acc) && !(budget <= acc)) acc = budget;
             }
             return acc;
         },
