@@ -154,6 +154,25 @@ TEST(LocalPeak, SeveralFieldsInOnePassAreEachFieldsOwnPeakExactly) {
             EXPECT_LE(one.value, one.raw);
         }
         EXPECT_NE(both[0].position, both[1].position) << "the two fields peak in different places";
+        // One point of another body a kilometre away: the cells of the points' box are then too
+        // many for the counting sort, and the sorted, hashed grouping must give the same sums in
+        // the same order (the far point, a body of its own far below every value, takes no part).
+        std::vector<measure::FieldPoint> far = points;
+        std::vector<double> far_a = a, far_b = b;
+        measure::FieldPoint outlier;
+        outlier.position = {1e3, 1e3, dim == 3 ? 1e3 : 0.0};
+        outlier.weight = 1.0;
+        outlier.body = 99;
+        far.push_back(outlier);
+        far_a.push_back(-1e300);
+        far_b.push_back(-1e300);
+        const std::array<std::span<const double>, 2> far_fields{far_a, far_b};
+        const auto hashed = measure::local_peaks(far, far_fields, 0.07, dim);
+        for (int f = 0; f < 2; ++f) {
+            EXPECT_EQ(hashed[f].value, both[f].value);
+            EXPECT_EQ(hashed[f].position, both[f].position);
+            EXPECT_EQ(hashed[f].raw, both[f].raw);
+        }
         const std::vector<double> short_field(points.size() - 1, 0.0);
         const std::array<std::span<const double>, 1> wrong{short_field};
         EXPECT_THROW(measure::local_peaks(points, wrong, 0.07, dim), std::invalid_argument);
