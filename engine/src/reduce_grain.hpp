@@ -12,10 +12,10 @@ namespace gpa {
 inline constexpr std::size_t reduce_grain = 4096;
 
 // Nodes per task of a loop over nodes whose result does not depend on how it is split (each node
-// writes its own values, or a minimum) and whose node costs tens of nanoseconds (a square root, a
-// division, a cube root): small enough that a scene of 10^3 nodes, a desktop's daily run, gives
-// both threads work, large enough that a task's overhead (about a microsecond) stays below a tenth
-// of its work.
+// writes its own values, or the loop takes a minimum, a maximum or an or) and whose node costs a
+// few to tens of nanoseconds (a division, a square root, a diameter rule): small enough that a
+// scene of 10^3 nodes, a desktop's daily run, gives both threads work, large enough that a task's
+// overhead (about a microsecond) stays small beside its work.
 inline constexpr std::size_t costly_node_grain = 256;
 
 // Ghosts per task of the loops that copy or mirror every field of a ghost's source (some twenty
