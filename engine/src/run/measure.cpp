@@ -158,12 +158,12 @@ std::vector<LocalPeak> local_peaks(std::span<const FieldPoint> points, std::span
     // read as contiguous runs.
     std::array<std::vector<double>, 3> x;
     for (int c = 0; c < dim; ++c) x[static_cast<std::size_t>(c)].resize(n);
-    std::vector<double> weight(n), value(n * nf);
+    std::vector<double> weight(n), ordered_value(n * nf);
     for (std::size_t k = 0; k < n; ++k) {
         const FieldPoint& q = points[order[k]];
         for (int c = 0; c < dim; ++c) x[static_cast<std::size_t>(c)][k] = q.position[static_cast<std::size_t>(c)];
         weight[k] = q.weight;
-        for (std::size_t f = 0; f < nf; ++f) value[f * n + k] = fields[f][order[k]];
+        for (std::size_t f = 0; f < nf; ++f) ordered_value[f * n + k] = fields[f][order[k]];
     }
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells, 16), [&](const tbb::blocked_range<std::size_t>& r) {
         std::vector<double> swf(nf);
@@ -203,7 +203,7 @@ std::vector<LocalPeak> local_peaks(std::span<const FieldPoint> points, std::span
                         const bool inside = !(d2 > r2);
                         const double w = weight[kq];
                         sw += inside ? w : -0.0;
-                        for (std::size_t f = 0; f < nf; ++f) swf[f] += inside ? w * value[f * n + kq] : -0.0;
+                        for (std::size_t f = 0; f < nf; ++f) swf[f] += inside ? w * ordered_value[f * n + kq] : -0.0;
                     }
                 }
                 for (std::size_t f = 0; f < nf; ++f) mean[f * n + p] = sw > 0.0 ? swf[f] / sw : fields[f][p];
