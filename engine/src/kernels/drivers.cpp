@@ -195,7 +195,8 @@ void gradient_impl(const CompressedRows& lists, const GradientFields<G::dim>& f,
                 sums.smallest_h = pair_smoothing_length(f.pairs.influence_distance, f.pairs.diameter[i], f.pairs.diameter[i]);
             }
             const Mat<D> L = velocity_gradient(sums, normalisation);
-            ok &= all_finite(L) & all_finite(normalisation);
+            ok &= all_finite(L);
+            ok &= all_finite(normalisation);
             if (!ok) {
                 record_smallest(first_bad, i);
                 continue;
