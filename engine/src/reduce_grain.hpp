@@ -1,5 +1,6 @@
 #pragma once
-// Private to engine/: the grain of the engine's parallel sums over nodes.
+// Private to engine/: how many nodes a task of the engine's parallel loops over nodes takes (sums, and
+// the loops whose result does not depend on where they are cut).
 
 #include <cstddef>
 
