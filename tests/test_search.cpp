@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "gpa/engine/ghosts.hpp"
+#include "gpa/engine/memory_use.hpp"
 #include "gpa/engine/neighbours.hpp"
 #include "support/lattices.hpp"
 
@@ -183,6 +184,43 @@ TEST(Search, GhostsWithinThePairsReachGiveEveryPairOfGhostsWithinTheLargestReach
         EXPECT_GT(ghost_pairs, 100u) << "the planes must be in reach of many pairs";
         EXPECT_LT(reach_ghosts * 2, wide_ghosts) << "a = " << a;
     }
+}
+
+// The ghosts' look-up (GhostSet::image_like) finds every ghost of a node across each combination
+// of planes and nothing else, and its table takes memory per source node, not per real node: a
+// cloud of 20000 nodes with two planes (three combinations: each plane and the corner) has a few
+// hundred nodes near them, and a table per real node would take 12 bytes for each of the 20000.
+TEST(Search, TheGhostTableFindsEveryGhostAndGrowsWithTheGhostsNotTheNodes) {
+    NodeStore n = random_cloud(GeometryKind::Axisymmetric, 20000, 11);
+    const std::size_t real = n.size();
+    GhostSet g({{"axis", 0, 0.0, +1, false, false}, {"floor", 1, 0.0, +1, false, false}});
+    g.update_contacts(n, real, true);
+    g.build(n, real, 0.03);
+    ASSERT_GT(g.count(), 200u);
+    ASSERT_LT(g.count(), real / 10);
+    // One ghost of each combination, as the `like` argument of image_like.
+    std::vector<NodeIndex> like_of_mask(8, 0);
+    std::vector<bool> seen(8, false);
+    for (std::size_t k = 0; k < g.count(); ++k) {
+        const auto m = g.planes_of(k);
+        if (!seen[m]) like_of_mask[m] = static_cast<NodeIndex>(real + k), seen[m] = true;
+    }
+    ASSERT_TRUE(seen[1] && seen[2] && seen[3]) << "each plane and the corner have ghosts";
+    // Every (node, combination) -> the ghost whose source and planes they are, or -1.
+    std::vector<std::int64_t> expected(real * 8, -1);
+    for (std::size_t k = 0; k < g.count(); ++k) expected[g.source(k) * 8 + g.planes_of(k)] = static_cast<std::int64_t>(real + k);
+    for (std::size_t i = 0; i < real; ++i) {
+        for (std::uint8_t m : {1, 2, 3}) {
+            ASSERT_EQ(g.image_like(real, like_of_mask[m], static_cast<NodeIndex>(i)), expected[i * 8 + m]) << "node " << i << ", planes " << int(m);
+        }
+    }
+    MemoryUse use;
+    g.memory_use(use);
+    const auto table = std::find_if(use.begin(), use.end(), [](const ArrayMemory& a) { return a.array == "ghosts: index per plane combination"; });
+    ASSERT_NE(table, use.end());
+    // Three slots of 4 bytes per source node, and no node has more than three ghosts.
+    EXPECT_LE(table->bytes, 3 * 4 * g.count());
+    EXPECT_LT(table->bytes, real);  // a table per real node: 12 * real
 }
 
 // With candidates that outlive switching, a fixed centre whose cells within reach hold only fixed

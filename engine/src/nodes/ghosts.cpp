@@ -91,7 +91,6 @@ GhostSet::GhostSet(std::vector<GhostPlane> planes) : planes_(std::move(planes)) 
         if (combines) masks_.push_back(static_cast<std::uint8_t>(m));
     }
     std::stable_sort(masks_.begin(), masks_.end(), [](std::uint8_t a, std::uint8_t b) { return std::popcount(a) < std::popcount(b); });
-    index_.resize(masks_.size());
     for (std::size_t p = 0; p < planes_.size(); ++p) {
         if (planes_[p].lift_off) lift_off_mask_ |= static_cast<std::uint8_t>(1u << p);
     }
@@ -167,12 +166,20 @@ std::size_t GhostSet::mask_slot(std::uint8_t mask) const {
     return static_cast<std::size_t>(it - masks_.begin());
 }
 
+std::int64_t GhostSet::ghost_of(NodeIndex node, std::size_t slot) const {
+    const auto it = std::lower_bound(sources_sorted_.begin(), sources_sorted_.end(), node);
+    if (it == sources_sorted_.end() || *it != node) return -1;
+    return ghost_table_[static_cast<std::size_t>(it - sources_sorted_.begin()) * masks_.size() + slot];
+}
+
 void GhostSet::build(NodeStore& nodes, std::size_t real_count, GhostReach reach, bool keep_between_searches) {
     keep_between_searches_ = keep_between_searches;
     source_.clear();
     mask_.clear();
     slot_.clear();
     sources_sorted_.clear();
+    ghost_table_.clear();
+    table_real_count_ = real_count;
     if (planes_.empty()) {
         nodes.resize(real_count);
         return;
@@ -209,18 +216,23 @@ void GhostSet::build(NodeStore& nodes, std::size_t real_count, GhostReach reach,
         throw InputError(fmt::format("{} nodes: too many for the ghost index (32-bit)", real_count));
     }
     for (std::size_t slot = 0; slot < masks_.size(); ++slot) {
-        index_[slot].assign(real_count, -1);
         for (std::size_t i = 0; i < real_count; ++i) {
             if (!needed[slot][i]) continue;
-            index_[slot][i] = static_cast<std::int32_t>(real_count + source_.size());
             source_.push_back(static_cast<NodeIndex>(i));
             mask_.push_back(masks_[slot]);
             slot_.push_back(static_cast<std::uint8_t>(slot));
         }
     }
+    std::vector<std::vector<std::uint8_t>>().swap(needed);
     sources_sorted_ = source_;
     std::sort(sources_sorted_.begin(), sources_sorted_.end());
     sources_sorted_.erase(std::unique(sources_sorted_.begin(), sources_sorted_.end()), sources_sorted_.end());
+    ghost_table_.assign(sources_sorted_.size() * masks_.size(), -1);
+    for (std::size_t k = 0; k < source_.size(); ++k) {
+        const auto row = static_cast<std::size_t>(std::lower_bound(sources_sorted_.begin(), sources_sorted_.end(), source_[k]) -
+                                                  sources_sorted_.begin());
+        ghost_table_[row * masks_.size() + slot_[k]] = static_cast<std::int32_t>(real_count + k);
+    }
     nodes.resize(real_count + source_.size());
     update(nodes, real_count);
     refresh(nodes, real_count);
@@ -301,15 +313,20 @@ GhostReach GhostSet::pair_reach(const NodeStore& nodes, std::size_t real_count, 
 
 bool GhostSet::covers(const NodeStore& nodes, std::size_t real_count, GhostReach reach) const {
     if (planes_.empty()) return true;
-    for (std::size_t slot = 0; slot < masks_.size(); ++slot) {
+    if (table_real_count_ != real_count) return false;
+    const std::size_t slots = masks_.size();
+    for (std::size_t slot = 0; slot < slots; ++slot) {
         const std::uint8_t m = masks_[slot];
-        const auto& index = index_[slot];
-        if (index.size() != real_count) return false;
         const bool missing = tbb::parallel_reduce(
             tbb::blocked_range<std::size_t>(0, real_count, costly_node_grain), false,
             [&](const tbb::blocked_range<std::size_t>& r, bool found) {
+                // The sources of the range walked alongside its nodes (both ascending).
+                auto source = std::lower_bound(sources_sorted_.begin(), sources_sorted_.end(), static_cast<NodeIndex>(r.begin()));
                 for (std::size_t i = r.begin(); i != r.end() && !found; ++i) {
-                    if (index[i] >= 0 || !selectable(nodes, i, m)) continue;
+                    while (source != sources_sorted_.end() && *source < i) ++source;
+                    const bool has_ghost = source != sources_sorted_.end() && *source == i &&
+                                           ghost_table_[static_cast<std::size_t>(source - sources_sorted_.begin()) * slots + slot] >= 0;
+                    if (has_ghost || !selectable(nodes, i, m)) continue;
                     bool near = true;
                     const double range = reach.of(nodes.diameter[i]);
                     for (std::size_t p = 0; p < planes_.size() && near; ++p) {
@@ -431,7 +448,7 @@ const CompressedRows& GhostSet::resolved_fixed_mirrors(const NodeStore& nodes, s
             const std::uint8_t m = nodes.fixed_mirror_planes[k];
             const NodeIndex j = nodes.fixed_mirrors.indices[k];
             if (!selectable(nodes, i, m) || !selectable(nodes, j, m)) continue;  // not touching a lift-off plane
-            const std::int64_t g = index_[mask_slot(m)][j];
+            const std::int64_t g = ghost_of(j, mask_slot(m));
             if (g < 0) throw NumericalError(fmt::format("node {}: its mirrored lattice neighbour has no ghost", i));
             resolved_.indices.push_back(static_cast<NodeIndex>(g));
         }
@@ -451,11 +468,12 @@ void GhostSet::append_ghost_rows(CompressedRows& lists, std::size_t real_count) 
     // passes below run over the sources in parallel without two writing one place, and a row's
     // entries keep the order of its source's row whatever the threads.
     // The ghost rows an entry goes to: s's own ghost across the planes of the ghost it lists, looked
-    // up once per source for each combination of planes (ghosts_of), then by the entry's slot.
+    // up in the source's row of the ghost table (a slot per combination of planes), by the entry's slot.
     const std::size_t slots = masks_.size();
-    const auto ghosts_of = [&](NodeIndex s, std::int32_t* out) {
-        for (std::size_t slot = 0; slot < slots; ++slot) out[slot] = index_[slot][s];
-    };
+    if (ghost_table_.size() != sources_sorted_.size() * slots) {
+        throw NumericalError(fmt::format("append_ghost_rows: a ghost table of {} entries for {} sources", ghost_table_.size(),
+                                         sources_sorted_.size()));
+    }
     constexpr std::size_t grain = 256;  // sources per task
     const tbb::blocked_range<std::size_t> all_sources(0, sources_sorted_.size(), grain);
     std::vector<std::size_t> count(ghosts + 1, 0);
@@ -463,13 +481,12 @@ void GhostSet::append_ghost_rows(CompressedRows& lists, std::size_t real_count) 
     tbb::parallel_for(all_sources, [&](const tbb::blocked_range<std::size_t>& r) {
         // The arrays' addresses and each row's end as locals: a store to count[] or next[] may
         // alias the offsets, so the loop would load them again after every entry.
-        std::vector<std::int32_t> ghost_of(slots);
         const NodeIndex* const indices = lists.indices.data();
         const std::uint8_t* const slot_of = slot_.data();
         std::size_t* const counts = count.data();
         for (std::size_t q = r.begin(); q != r.end(); ++q) {
             const NodeIndex s = sources_sorted_[q];
-            ghosts_of(s, ghost_of.data());
+            const std::int32_t* const ghost_of = ghost_table_.data() + q * slots;
             const std::size_t last = lists.offsets[s + 1];
             bool missing = false;
             // Without a branch on whether an entry is a ghost, which no predictor guesses (about a
@@ -502,14 +519,13 @@ void GhostSet::append_ghost_rows(CompressedRows& lists, std::size_t real_count) 
     std::vector<std::size_t> next(ghosts);
     for (std::size_t k = 0; k < ghosts; ++k) next[k] = base + count[k];
     tbb::parallel_for(all_sources, [&](const tbb::blocked_range<std::size_t>& r) {
-        std::vector<std::int32_t> ghost_of(slots);
         NodeIndex* const indices = lists.indices.data();
         const std::uint8_t* const slot_of = slot_.data();
         const NodeIndex* const sources = source_.data();
         std::size_t* const place = next.data();
         for (std::size_t q = r.begin(); q != r.end(); ++q) {
             const NodeIndex s = sources_sorted_[q];
-            ghosts_of(s, ghost_of.data());
+            const std::int32_t* const ghost_of = ghost_table_.data() + q * slots;
             const std::size_t last = lists.offsets[s + 1];
             // (Here the branch stays: without it, every real entry would add 0 to one place, a chain
             // of loads and stores through memory that costs more than the guesses it misses.)
@@ -574,11 +590,12 @@ void GhostSet::write_state(StateWriter& out) const {
     out.tag("GHST");
     out.value<std::uint64_t>(planes_.size());
     out.value<std::uint64_t>(masks_.size());
-    for (const auto& index : index_) out.array(index);
     out.array(source_);
     out.array(mask_);
     out.array(slot_);
     out.array(sources_sorted_);
+    out.value<std::uint64_t>(table_real_count_);
+    out.array(ghost_table_);
     out.value<std::uint8_t>(keep_between_searches_ ? 1 : 0);
     write_rows(out, resolved_);
 }
@@ -588,17 +605,12 @@ void GhostSet::read_state(StateReader& in, std::size_t real_count, std::size_t n
     if (in.value<std::uint64_t>() != planes_.size() || in.value<std::uint64_t>() != masks_.size()) {
         in.fail("its planes are not the scene's");
     }
-    for (auto& index : index_) {
-        in.array(index);
-        if (!index.empty() && index.size() != real_count) in.fail("a ghost table has the wrong length (a damaged checkpoint)");
-        for (const std::int32_t g : index) {
-            if (g < -1 || g >= static_cast<std::int64_t>(node_count)) in.fail("a ghost table names a node that does not exist");
-        }
-    }
     in.array(source_);
     in.array(mask_);
     in.array(slot_);
     in.array(sources_sorted_);
+    table_real_count_ = static_cast<std::size_t>(in.value<std::uint64_t>());
+    in.array(ghost_table_);
     const std::size_t ghosts = source_.size();
     if (mask_.size() != ghosts || slot_.size() != ghosts || real_count + ghosts != node_count) {
         in.fail("its ghosts do not match its nodes (a damaged checkpoint)");
@@ -606,9 +618,27 @@ void GhostSet::read_state(StateReader& in, std::size_t real_count, std::size_t n
     for (std::size_t k = 0; k < ghosts; ++k) {
         if (source_[k] >= real_count || slot_[k] >= masks_.size()) in.fail("a ghost has no source (a damaged checkpoint)");
     }
-    for (const NodeIndex s : sources_sorted_) {
-        if (s >= real_count) in.fail("a ghost source does not exist (a damaged checkpoint)");
+    for (std::size_t q = 0; q < sources_sorted_.size(); ++q) {
+        if (sources_sorted_[q] >= real_count) in.fail("a ghost source does not exist (a damaged checkpoint)");
+        if (q > 0 && !(sources_sorted_[q - 1] < sources_sorted_[q])) in.fail("the ghost sources are out of order (a damaged checkpoint)");
     }
+    // The table: one row per source, its entries -1 or a ghost of that source across that
+    // combination, and every ghost in its place (ghost_of then finds each ghost, and only ghosts).
+    if (ghost_table_.size() != sources_sorted_.size() * masks_.size() || (!source_.empty() && table_real_count_ != real_count)) {
+        in.fail("a ghost table has the wrong length (a damaged checkpoint)");
+    }
+    std::size_t listed = 0;
+    for (std::size_t e = 0; e < ghost_table_.size(); ++e) {
+        const std::int32_t g = ghost_table_[e];
+        if (g == -1) continue;
+        const std::size_t k = static_cast<std::size_t>(g) - real_count;
+        if (g < 0 || static_cast<std::size_t>(g) < real_count || k >= ghosts || source_[k] != sources_sorted_[e / masks_.size()] ||
+            slot_[k] != e % masks_.size()) {
+            in.fail("a ghost table names a node that is not that ghost (a damaged checkpoint)");
+        }
+        ++listed;
+    }
+    if (listed != ghosts) in.fail("a ghost table leaves out some ghosts (a damaged checkpoint)");
     keep_between_searches_ = in.value<std::uint8_t>() != 0;
     in.array(resolved_.offsets);
     in.array(resolved_.indices);
@@ -621,9 +651,7 @@ void GhostSet::read_state(StateReader& in, std::size_t real_count, std::size_t n
 }
 
 void GhostSet::memory_use(MemoryUse& out) const {
-    std::size_t index = 0;
-    for (const auto& slot : index_) index += allocated_bytes(slot);
-    add_memory(out, "ghosts: index per plane combination", index);
+    add_memory(out, "ghosts: index per plane combination", allocated_bytes(ghost_table_));
     add_memory(out, "ghosts: sources", allocated_bytes(source_) + allocated_bytes(mask_) + allocated_bytes(slot_) +
                                            allocated_bytes(sources_sorted_));
     add_memory(out, "ghosts: resolved lattice mirrors", allocated_bytes(resolved_.indices) + allocated_bytes(resolved_.offsets));

@@ -255,8 +255,9 @@ public:
     // Reads the header of a checkpoint (no Simulation needed). Throws CheckpointError.
     static CheckpointInfo checkpoint_info(std::istream& in, std::uint64_t size, const std::string& source);
     // The format version save_checkpoint writes.
-    // 4: a section per part of the step; 5: element bodies; 6: B of 3D nodes; 7: external loads
-    static constexpr std::uint32_t checkpoint_format = 7;
+    // 4: a section per part of the step; 5: element bodies; 6: B of 3D nodes; 7: external loads;
+    // 8: the ghosts' table per source (GhostSet)
+    static constexpr std::uint32_t checkpoint_format = 8;
 
 private:
     struct Impl;
