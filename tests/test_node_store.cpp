@@ -1,5 +1,6 @@
 // NodeStore: resizing, permuting and the set-up of lattice nodes (spec section 12).
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <numeric>
@@ -8,6 +9,11 @@
 #include <gtest/gtest.h>
 
 #include "gpa/engine/kernels.hpp"
+#include "gpa/engine/errors.hpp"
+#include "gpa/engine/memory_use.hpp"
+#include "gpa/engine/neighbours.hpp"
+#include "gpa/engine/fields.hpp"
+#include "gpa/engine/drivers.hpp"
 #include "gpa/engine/lattice.hpp"
 #include "gpa/engine/weights.hpp"
 #include "support/lattices.hpp"
@@ -37,6 +43,31 @@ TEST(NodeStore, PermuteMovesEveryFieldAndRenamesFixedLists) {
             EXPECT_EQ(order[n.fixed_neighbours.row(k)[m]], original.fixed_neighbours.row(old)[m]);
         }
     }
+}
+
+// A store that dropped alpha_shear leaves it out of resizing and reordering, and the gradient
+// refuses the full normalisation on it with an error instead of writing through a null pointer.
+TEST(NodeStore, ADroppedShearNormalisationStaysEmptyAndTheFullNormalisationIsRefused) {
+    auto n = testing::make_lattice({GeometryKind::PlaneStrain, 6, 0.5, 0.0, Connectivity::Variable, 8, 1.0});
+    ASSERT_TRUE(n.carries_shear_normalisation());
+    ASSERT_EQ(n.alpha_shear[0].size(), n.size());
+    n.drop_shear_normalisation();
+    EXPECT_FALSE(n.carries_shear_normalisation());
+    n.resize(n.size() + 3);
+    n.resize(n.size() - 3);
+    std::vector<NodeIndex> order(n.size());
+    std::iota(order.rbegin(), order.rend(), 0u);
+    n.permute(order);
+    EXPECT_EQ(n.alpha_shear[0].capacity(), 0u);
+    MemoryUse use;
+    n.memory_use(use);
+    EXPECT_TRUE(std::none_of(use.begin(), use.end(), [](const ArrayMemory& a) { return a.array == "nodes: alpha_shear"; }));
+    const CompressedRows lists = find_neighbours(n, 1.0, n.size());
+    auto f = gradient_fields<2>(n, 1.0);
+    f.full_normalisation = true;
+    EXPECT_THROW(compute_velocity_gradient<PlaneStrain>(lists, WeightKind::Gpa, f), InputError);
+    f.full_normalisation = false;
+    EXPECT_NO_THROW(compute_velocity_gradient<PlaneStrain>(lists, WeightKind::Gpa, f));
 }
 
 TEST(Lattice, NodesSitAtCellCentresWithTheirRingVolumes) {

@@ -266,6 +266,30 @@ TEST(MemoryUse, ThreadsLookingNodesUpAtOnceAfterAReorderEachFindEveryNode) {
     }
 }
 
+// The off-diagonal normalisation (alpha_shear, three arrays in 3D) is carried only by a run with
+// the moment matrix, which writes and reads it: with the per-direction normalisation (the default)
+// it is not in the memory table at all, and the run steps without it.
+TEST(MemoryUse, OnlyTheMomentMatrixCarriesTheOffDiagonalNormalisation) {
+    const auto has_array = [](const Simulation& sim, const std::string& array) {
+        const MemoryUse use = sim.memory_use();
+        return std::any_of(use.begin(), use.end(), [&](const ArrayMemory& a) { return a.array == array; });
+    };
+    Scene per_direction = quarter_bar(ConnectivityMode::Variable);
+    Simulation plain(per_direction, 2);
+    for (int k = 0; k < 3; ++k) plain.step();
+    EXPECT_FALSE(has_array(plain, "nodes: alpha_shear"));
+    EXPECT_FALSE(plain.nodes().carries_shear_normalisation());
+    Scene full = per_direction;
+    full.solver.normalisation = Normalisation::MomentMatrix;
+    Simulation moment(full, 2);
+    for (int k = 0; k < 3; ++k) moment.step();
+    EXPECT_GE(bytes_of(moment, "nodes: alpha_shear"), 3 * 8 * moment.nodes().size());
+    // It is written: some node's normalisation has off-diagonal entries once the bar has moved.
+    double largest = 0.0;
+    for (std::size_t i = 0; i < moment.real_count(); ++i) largest = std::max(largest, std::abs(moment.nodes().alpha_shear[2][i]));
+    EXPECT_GT(largest, 0.0);
+}
+
 TEST(MemoryUse, ASceneWithFixedNodesKeepsItsLatticeLists) {
     Simulation sim(quarter_bar(ConnectivityMode::Automatic), 2);
     for (int k = 0; k < 3; ++k) sim.step();

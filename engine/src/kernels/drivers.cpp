@@ -432,6 +432,7 @@ template <class G>
 void compute_stress_power(const CompressedRows& lists, WeightKind weight, const ForceFields<G::dim>& f,
                           const std::array<const double*, G::dim>& velocity, std::size_t real_count, double* power,
                           double* viscous_power, const HourglassFields<G::dim>* hourglass, double hourglass_coefficient) {
+    if (f.full_normalisation && !f.alpha_shear[0]) throw InputError("compute_stress_power: the full normalisation needs alpha_shear");
     dispatch_weight(weight, [&](auto w) {
         if (hourglass && hourglass->quadratic) {
             stress_power_impl<G, decltype(w), true>(lists, f, velocity, real_count, power, viscous_power, hourglass,
@@ -447,6 +448,10 @@ template <class G>
 void compute_velocity_gradient(const CompressedRows& lists, WeightKind weight, const GradientFields<G::dim>& f,
                                std::size_t centres) {
     const std::size_t n = std::min(centres, lists.rows());
+    if (f.full_normalisation && !f.alpha_shear[0]) {
+        throw InputError("compute_velocity_gradient: the full normalisation needs alpha_shear (a node store that dropped it "
+                         "serves the per-direction normalisation only)");
+    }
     dispatch_weight(weight, [&](auto w) {
         if (f.full_normalisation) {
             gradient_impl<G, decltype(w), true>(lists, f, n);

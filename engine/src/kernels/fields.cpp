@@ -44,7 +44,7 @@ GradientFields<D> gradient_fields(NodeStore& nodes, InfluenceDistance influence_
         g.alpha[c] = nodes.alpha[c].data();
     }
     for (int c = 0; c < D * D; ++c) g.velocity_gradient[c] = nodes.velocity_gradient[c].data();
-    for (int c = 0; c < (D == 3 ? 3 : 1); ++c) g.alpha_shear[c] = nodes.alpha_shear[c].data();
+    for (int c = 0; c < (D == 3 ? 3 : 1); ++c) g.alpha_shear[c] = nodes.carries_shear_normalisation() ? nodes.alpha_shear[c].data() : nullptr;
     g.size_weight = nodes.size_weight.data();
     g.volumetric_strain_rate = nodes.volumetric_strain_rate.data();
     g.smallest_h = nodes.smallest_h.data();
@@ -68,7 +68,7 @@ ForceFields<D> force_fields(NodeStore& nodes, InfluenceDistance influence_distan
     f.viscous_pressure = nodes.viscous_pressure.data();
     f.mass = nodes.mass.data();
     f.sound_speed = nodes.sound_speed.data();
-    for (int c = 0; c < (D == 3 ? 3 : 1); ++c) f.alpha_shear[c] = nodes.alpha_shear[c].data();
+    for (int c = 0; c < (D == 3 ? 3 : 1); ++c) f.alpha_shear[c] = nodes.carries_shear_normalisation() ? nodes.alpha_shear[c].data() : nullptr;
     f.hoop_count = nodes.size();
     return f;
 }

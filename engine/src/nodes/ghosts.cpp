@@ -395,7 +395,8 @@ void GhostSet::refresh(NodeStore& nodes, std::size_t real_count) const {
     // oblique one it is H A H; the per-direction normalisation, which keeps the diagonal only (its
     // alpha_shear is zero), takes the diagonal of H A H: the frame-dependence of that normalisation
     // (docs/orientation.md, "Oblique planes in the step").
-    const int first_shear = dim == 2 ? 2 : 3, shears = dim == 2 ? 1 : 3;
+    // (A store without alpha_shear, dropped for the per-direction normalisation: the diagonal alone.)
+    const int first_shear = dim == 2 ? 2 : 3, shears = !nodes.carries_shear_normalisation() ? 0 : (dim == 2 ? 1 : 3);
     std::array<double*, 6> stress{}, normalisation{};
     for (int c = 0; c < comps; ++c) stress[c] = nodes.deviatoric_stress[c].data();
     for (int c = 0; c < dim; ++c) normalisation[c] = nodes.alpha[c].data();

@@ -40,7 +40,7 @@ void NodeStore::for_each_field(F&& f) {
         f("force", force[c]);
     }
     for (int c = 0; c < d * d; ++c) f("velocity_gradient", velocity_gradient[c]);
-    for (int c = 0; c < (d == 3 ? 3 : 1); ++c) f("alpha_shear", alpha_shear[c]);
+    for (int c = 0; c < (carries_shear_ ? (d == 3 ? 3 : 1) : 0); ++c) f("alpha_shear", alpha_shear[c]);
     for (int c = 0; c < stress_components(d); ++c) f("deviatoric_stress", deviatoric_stress[c]);
     for (int c = 0; c < (d == 3 ? 6 : 0); ++c) f("left_cauchy_green", left_cauchy_green[c]);
     f("mass", mass);
@@ -150,6 +150,11 @@ void NodeStore::carry_reference_positions() {
         reference_position[c] = position[c];
         reference_position[c].reserve(position[c].capacity());
     }
+}
+
+void NodeStore::drop_shear_normalisation() {
+    carries_shear_ = false;
+    for (auto& field : alpha_shear) std::vector<double>().swap(field);
 }
 
 void NodeStore::permute(std::span<const NodeIndex> new_to_old) {

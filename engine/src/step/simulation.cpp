@@ -162,6 +162,7 @@ void Simulation::Impl::setup() {
     real = nodes.size();
     particles = real > 0;
     if (relaxing_stiffness(scene.solver)) nodes.carry_reference_positions();
+    if (scene.solver.normalisation != Normalisation::MomentMatrix) nodes.drop_shear_normalisation();
     if (std::any_of(scene.bodies.begin(), scene.bodies.end(),
                     [](const BodySpec& b) { return b.discretisation == Discretisation::Elements; })) {
         elements = std::make_unique<ElementPart>(scene, mesh_element_bodies(scene), element_options(scene));

@@ -51,6 +51,12 @@ public:
     // stiffness never calls it and carries nothing.
     void carry_reference_positions();
     bool carries_reference_positions() const { return carries_reference_; }
+    // From now on alpha_shear is not one of the fields: its arrays are freed, and resizing,
+    // reordering, checkpoints and the memory report leave it out. For a run with the per-direction
+    // normalisation, which never writes or reads it (8 bytes per node in 2D, 24 in 3D). A store
+    // carries it until this is called.
+    void drop_shear_normalisation();
+    bool carries_shear_normalisation() const { return carries_shear_; }
     // Frees the lattice lists when no row has an entry (fixed_neighbours below); the set-up calls it
     // once the lattices are prepared.
     void release_empty_lattice_rows();
@@ -102,7 +108,7 @@ public:
     // --- results of the gradient and force phases, rewritten every step ------------------
     std::array<std::vector<double>, 3> alpha;              // geometry factors (Eq. 14, 15, 51-53)
     std::array<std::vector<double>, 3> alpha_shear;        // off-diagonal normalisation (full only):
-                                                           // 2D xz; 3D yz, xz, xy
+                                                           // 2D xz; 3D yz, xz, xy; empty once dropped
     std::array<std::vector<double>, 9> velocity_gradient;  // L_ab at [a * dim + b]
     std::vector<double> volumetric_strain_rate;            // eps_v_dot (Eq. 12), with hoop term
     std::vector<double> smallest_h;                        // min_j h_ij
@@ -130,6 +136,7 @@ private:
     GeometryKind geometry_;
     int dim_;
     bool carries_reference_ = false;
+    bool carries_shear_ = true;
 };
 
 // Checks what the method cannot work with, for nodes [first, last): a non-finite or (in
