@@ -391,6 +391,35 @@ void check_kept_pair_terms(const ForceCase& s, bool full_normalisation) {
     compute_stress_power<G>(lists, s.weight, f_kept, v, kept.size(), power_kept.data(), viscous_kept.data());
     EXPECT_EQ(power_fresh, power_kept) << name(s);
     EXPECT_EQ(viscous_fresh, viscous_kept) << name(s);
+    // Booked straight into the energies (StressPowerOut, as the energy ledger does): each node's
+    // energy and viscous work change by exactly what the ledger once booked from the two arrays.
+    {
+        NodeStore booked = kept;
+        for (std::size_t i = 0; i < booked.size(); ++i) {
+            booked.internal_energy[i] = 1e5 + 10.0 * double(i);
+            booked.viscous_work[i] = 3.0 * double(i);
+        }
+        const NodeStore before = booked;
+        StressPowerOut out;
+        out.internal_energy = booked.internal_energy.data();
+        out.viscous_work = booked.viscous_work.data();
+        out.mass = booked.mass.data();
+        out.dt = 2.5e-9;
+        compute_stress_power<G>(lists, s.weight, f_kept, v, booked.size(), out);
+        bool any_change = false;
+        for (std::size_t i = 0; i < booked.size(); ++i) {
+            double e = before.internal_energy[i], w = before.viscous_work[i];
+            const double m = booked.mass[i];
+            e -= power_kept[i] * out.dt / m;
+            w -= viscous_kept[i] * out.dt / m;
+            ASSERT_EQ(booked.internal_energy[i], e) << name(s) << " node " << i;
+            ASSERT_EQ(booked.viscous_work[i], w) << name(s) << " node " << i;
+            any_change |= e != before.internal_energy[i];
+        }
+        EXPECT_TRUE(any_change) << name(s) << ": the velocities must do work";
+        StressPowerOut nowhere;
+        EXPECT_THROW(compute_stress_power<G>(lists, s.weight, f_kept, v, booked.size(), nowhere), InputError);
+    }
     SmoothingScratch scratch_fresh, scratch_kept;
     std::array<double*, D> v_fresh{}, v_kept{};
     for (int c = 0; c < D; ++c) {

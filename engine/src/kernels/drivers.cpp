@@ -368,8 +368,8 @@ void stress_difference_impl(const CompressedRows& lists, const ScatterPlan& plan
 // fit; KeptDampingPower), chosen once for the pass.
 template <class G, class W, bool CurvedDamping>
 void stress_power_impl(const CompressedRows& lists, const ForceFields<G::dim>& f,
-                       const std::array<const double*, G::dim>& velocity, std::size_t n, double* power,
-                       double* viscous_power, const HourglassFields<G::dim>* hourglass, double hourglass_coefficient) {
+                       const std::array<const double*, G::dim>& velocity, std::size_t n, const StressPowerOut& out,
+                       const HourglassFields<G::dim>* hourglass, double hourglass_coefficient) {
     constexpr int D = G::dim;
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, row_grain), [&](const tbb::blocked_range<std::size_t>& range) {
         for (std::size_t i = range.begin(); i != range.end(); ++i) {
@@ -407,8 +407,15 @@ void stress_power_impl(const CompressedRows& lists, const ForceFields<G::dim>& f
                 sum += hoop * v_i[0];
                 divergence += hoop_strain_rate(v_i[0], f.pairs.position[0][i]);
             }
-            power[i] = sum;
-            viscous_power[i] = q * volume * divergence;
+            const double viscous = q * volume * divergence;
+            if (out.internal_energy) {
+                const double m = out.mass[i];
+                out.internal_energy[i] -= sum * out.dt / m;
+                out.viscous_work[i] -= viscous * out.dt / m;
+            } else {
+                out.power[i] = sum;
+                out.viscous_power[i] = viscous;
+            }
             if (hourglass) {
                 hourglass->power[i] = damping_power;
                 if (hourglass->stiffness_power) {
@@ -430,18 +437,29 @@ void stress_power_impl(const CompressedRows& lists, const ForceFields<G::dim>& f
 
 template <class G>
 void compute_stress_power(const CompressedRows& lists, WeightKind weight, const ForceFields<G::dim>& f,
-                          const std::array<const double*, G::dim>& velocity, std::size_t real_count, double* power,
-                          double* viscous_power, const HourglassFields<G::dim>* hourglass, double hourglass_coefficient) {
+                          const std::array<const double*, G::dim>& velocity, std::size_t real_count, const StressPowerOut& out,
+                          const HourglassFields<G::dim>* hourglass, double hourglass_coefficient) {
     if (f.full_normalisation && !f.alpha_shear[0]) throw InputError("compute_stress_power: the full normalisation needs alpha_shear");
+    if (out.internal_energy ? !(out.viscous_work && out.mass) : !(out.power && out.viscous_power)) {
+        throw InputError("compute_stress_power: no place for the powers (both arrays, or the energies, viscous work and masses)");
+    }
     dispatch_weight(weight, [&](auto w) {
         if (hourglass && hourglass->quadratic) {
-            stress_power_impl<G, decltype(w), true>(lists, f, velocity, real_count, power, viscous_power, hourglass,
-                                                    hourglass_coefficient);
+            stress_power_impl<G, decltype(w), true>(lists, f, velocity, real_count, out, hourglass, hourglass_coefficient);
         } else {
-            stress_power_impl<G, decltype(w), false>(lists, f, velocity, real_count, power, viscous_power, hourglass,
-                                                     hourglass_coefficient);
+            stress_power_impl<G, decltype(w), false>(lists, f, velocity, real_count, out, hourglass, hourglass_coefficient);
         }
     });
+}
+
+template <class G>
+void compute_stress_power(const CompressedRows& lists, WeightKind weight, const ForceFields<G::dim>& f,
+                          const std::array<const double*, G::dim>& velocity, std::size_t real_count, double* power,
+                          double* viscous_power, const HourglassFields<G::dim>* hourglass, double hourglass_coefficient) {
+    StressPowerOut out;
+    out.power = power;
+    out.viscous_power = viscous_power;
+    compute_stress_power<G>(lists, weight, f, velocity, real_count, out, hourglass, hourglass_coefficient);
 }
 
 template <class G>
@@ -500,6 +518,15 @@ template void compute_stress_power<Axisymmetric>(const CompressedRows&, WeightKi
                                           const HourglassFields<2>*, double);
 template void compute_stress_power<ThreeD>(const CompressedRows&, WeightKind, const ForceFields<3>&,
                                           const std::array<const double*, 3>&, std::size_t, double*, double*,
+                                          const HourglassFields<3>*, double);
+template void compute_stress_power<PlaneStrain>(const CompressedRows&, WeightKind, const ForceFields<2>&,
+                                          const std::array<const double*, 2>&, std::size_t, const StressPowerOut&,
+                                          const HourglassFields<2>*, double);
+template void compute_stress_power<Axisymmetric>(const CompressedRows&, WeightKind, const ForceFields<2>&,
+                                          const std::array<const double*, 2>&, std::size_t, const StressPowerOut&,
+                                          const HourglassFields<2>*, double);
+template void compute_stress_power<ThreeD>(const CompressedRows&, WeightKind, const ForceFields<3>&,
+                                          const std::array<const double*, 3>&, std::size_t, const StressPowerOut&,
                                           const HourglassFields<3>*, double);
 template void compute_velocity_gradient<PlaneStrain>(const CompressedRows&, WeightKind,
                                                 const GradientFields<PlaneStrain::dim>&, std::size_t);

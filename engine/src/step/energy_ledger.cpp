@@ -96,8 +96,6 @@ void EnergyLedger::compatible_powers(const CompressedRows& lists, WeightKind wei
     if (!ghosts.empty()) ghosts.mirror_vector_field(mean_out, D, real);
     std::array<const double*, D> mean{};
     for (int c = 0; c < D; ++c) mean[c] = mean_velocity_[c].data();
-    stress_power_.resize(real);
-    viscous_power_.resize(real);
     // The hourglass forces' power in the same pass (made from the half-step velocities, as in the
     // force pass, their power taken at the mean velocities: the kinetic energy they remove in this
     // update).
@@ -113,15 +111,20 @@ void EnergyLedger::compatible_powers(const CompressedRows& lists, WeightKind wei
             control->power_velocity[c] = mean[c];
         }
     }
-    compute_stress_power<G>(lists, weight, forces, mean, real, stress_power_.data(), viscous_power_.data(),
-                            control ? &*control : nullptr, hourglass_coefficient);
-    stress_powers_due_ = true;
+    // The stress work and its nodal-viscosity share booked in the same pass (StressPowerOut), first of
+    // the step's bookings as book() once did them: the same operations in the same order per node.
+    StressPowerOut booking;
+    booking.internal_energy = nodes.internal_energy.data();
+    booking.viscous_work = nodes.viscous_work.data();
+    booking.mass = nodes.mass.data();
+    booking.dt = dt_avg;
+    compute_stress_power<G>(lists, weight, forces, mean, real, booking, control ? &*control : nullptr, hourglass_coefficient);
 }
 
 void EnergyLedger::book(NodeStore& nodes, std::size_t real, double dt_avg) {
-    const bool stress = stress_powers_due_;
-    stress_powers_due_ = false;
-    if (!stress && !bond_ && !hourglass_) return;
+    // (The stress forces' work and its nodal-viscosity share are booked before this, by the
+    // compatible pass itself: compatible_powers.)
+    if (!bond_ && !hourglass_) return;
     using Sums = std::array<double, 2>;  // hourglass heat, stored hourglass energy
     const Sums sums = tbb::parallel_deterministic_reduce(
         tbb::blocked_range<std::size_t>(0, real, reduce_grain), Sums{0.0, 0.0},
@@ -130,11 +133,6 @@ void EnergyLedger::book(NodeStore& nodes, std::size_t real, double dt_avg) {
                 const double m = nodes.mass[i];
                 double& e = nodes.internal_energy[i];
                 double& viscous = nodes.viscous_work[i];
-                if (stress) {
-                    // The stress forces' work, and the share of it done by the nodal viscosity.
-                    e -= stress_power_[i] * dt_avg / m;
-                    viscous -= viscous_power_[i] * dt_avg / m;
-                }
                 if (bond_) {
                     // The work of the bond-viscous forces becomes heat of the centre (spec section 5).
                     const double heat = -bond_power_[i] * dt_avg / m;
@@ -166,8 +164,7 @@ void EnergyLedger::book(NodeStore& nodes, std::size_t real, double dt_avg) {
 
 void EnergyLedger::memory_use(MemoryUse& out) const {
     add_memory(out, "energy ledger: powers per node", allocated_bytes(bond_power_) + allocated_bytes(hourglass_power_) +
-                                                          allocated_bytes(stiffness_power_) + allocated_bytes(stress_power_) +
-                                                          allocated_bytes(viscous_power_));
+                                                          allocated_bytes(stiffness_power_));
     std::size_t velocities = 0;
     for (const auto& v : mean_velocity_) velocities += allocated_bytes(v);
     for (const auto& v : half_velocity_) velocities += allocated_bytes(v);

@@ -54,7 +54,9 @@ public:
     // After the velocity update and the prescribed components (compatible update only): the work of
     // each centre's stress forces and, with the hourglass control, of its control forces at the mean
     // velocities v_mean = v^{n+3/2} - dt_avg F / (2 M) (held components: the mean of their two half
-    // steps; ghosts mirrored), in one visit of every row (drivers.hpp, compute_stress_power).
+    // steps; ghosts mirrored), in one visit of every row (drivers.hpp, compute_stress_power). The
+    // stress work and its nodal-viscosity share are booked into the nodes in that visit, the first
+    // of the step's bookings (book() does the rest); the control's powers go to the ledger's arrays.
     // `forces` and `control` are the fields of the force pass (control: none without the control;
     // its velocities and outputs are set here: the kept half-step velocities, the ledger's arrays).
     template <class G>
@@ -64,8 +66,8 @@ public:
                            const std::vector<PrescribedVelocitySpec>& regions, GhostSet& ghosts);
 
     // Books the step's work and heat into the real nodes (one pass, in a fixed order per node and a
-    // fixed order of the sums, so that nothing depends on the thread count): the compatible stress
-    // work (when computed), bond-viscous heat, hourglass heat and stored hourglass energy.
+    // fixed order of the sums, so that nothing depends on the thread count): bond-viscous heat,
+    // hourglass heat and stored hourglass energy, after the compatible stress work (compatible_powers).
     void book(NodeStore& nodes, std::size_t real, double dt_avg);
 
     void add_boundary_work(double work) { boundary_work_ += work; }
@@ -86,12 +88,10 @@ private:
     bool damping_ = false;  // the hourglass control's damping form (C_hg > 0)
     bool quadratic_ = false;  // its quadratic fit (SolverOptions::hourglass_fit)
     bool relaxing_ = false;   // the stiffness on flowing nodes too (relaxing_stiffness)
-    bool stress_powers_due_ = false;  // compatible_powers ran this step: book the stress work
     double boundary_work_ = 0.0;
     double hourglass_work_ = 0.0;
     double hourglass_energy_ = 0.0;
     std::vector<double> bond_power_, hourglass_power_, stiffness_power_;  // per node of the force pass
-    std::vector<double> stress_power_, viscous_power_;                   // per real node
     std::array<std::vector<double>, 3> mean_velocity_;                    // per node, ghosts mirrored
     std::array<std::vector<double>, 3> half_velocity_;                    // per node, ghosts included
     // The force pass's hourglass fits per real node: the scale, then the D * D matrix entries.

@@ -60,4 +60,22 @@ void compute_stress_power(const CompressedRows& lists, WeightKind weight, const 
                           double* viscous_power, const HourglassFields<G::dim>* hourglass = nullptr,
                           double hourglass_coefficient = 0.0);
 
+// Where the pass above puts each centre's two powers: in the arrays `power` and `viscous_power`,
+// or, with `internal_energy` set, straight into the centre's specific energies as the energy
+// ledger books them (EnergyLedger::book: e_i -= power_i dt / m_i, w_v,i -= viscous_power_i dt / m_i,
+// the same operations on the same numbers), so that a run holds no array of either (16 bytes per
+// node).
+struct StressPowerOut {
+    double* power = nullptr;
+    double* viscous_power = nullptr;
+    double* internal_energy = nullptr;
+    double* viscous_work = nullptr;
+    const double* mass = nullptr;
+    double dt = 0.0;
+};
+template <class G>
+void compute_stress_power(const CompressedRows& lists, WeightKind weight, const ForceFields<G::dim>& f,
+                          const std::array<const double*, G::dim>& velocity, std::size_t real_count, const StressPowerOut& out,
+                          const HourglassFields<G::dim>* hourglass = nullptr, double hourglass_coefficient = 0.0);
+
 }  // namespace gpa
