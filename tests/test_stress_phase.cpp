@@ -103,6 +103,37 @@ TEST(StressPhase, APointBeyondItsEquationOfStateIsLeftAsItWasAndNamedAfterTheLoo
     }
 }
 
+// A scene of one material keeps no list of its nodes (group_by_material: every node is of that
+// material), two materials keep a list each; the steps give the same bits either way, and the
+// same as the lists the phase took before.
+TEST(StressPhase, OneMaterialNeedsNoListOfItsNodesAndGivesTheSameBits) {
+    Block listed = sheared_block({{3, -2e4}, {130, 3e4}});
+    Block whole = listed;
+    const MaterialGroups one = group_by_material(whole.nodes, whole.nodes.size(), whole.materials.size());
+    ASSERT_TRUE(one.every_node_of.has_value());
+    EXPECT_EQ(*one.every_node_of, 0u);
+    EXPECT_TRUE(one.members.empty());
+    constexpr double dt = 1e-8;
+    StressPhaseOptions options;
+    for (int step = 0; step < 10; ++step) {
+        update_stresses<PlaneStrain>(listed.nodes, listed.nodes.size(), listed.materials, listed.groups, dt, options);
+        update_stresses<PlaneStrain>(whole.nodes, whole.nodes.size(), whole.materials, one, dt, options);
+    }
+    for (std::size_t i = 0; i < listed.nodes.size(); ++i) ASSERT_EQ(point_fields(whole.nodes, i), point_fields(listed.nodes, i)) << "node " << i;
+    EXPECT_GT(whole.nodes.plastic_strain[3], 0.0);
+    // Two materials: a list each, every node in its own material's.
+    Block two = sheared_block({});
+    two.materials.push_back(copper());
+    for (std::size_t i = 0; i < two.nodes.size(); i += 3) two.nodes.material[i] = 1;
+    const MaterialGroups lists = group_by_material(two.nodes, two.nodes.size(), two.materials.size());
+    ASSERT_FALSE(lists.every_node_of.has_value());
+    ASSERT_EQ(lists.members.size(), 2u);
+    EXPECT_EQ(lists.members[0].size() + lists.members[1].size(), two.nodes.size());
+    for (std::size_t m = 0; m < 2; ++m) {
+        for (NodeIndex i : lists.members[m]) EXPECT_EQ(two.nodes.material[i], static_cast<std::int32_t>(m));
+    }
+}
+
 TEST(StressPhase, TheGroupLoopGivesEachPointTheStateOfItsOwnUpdateBitForBit) {
     // The group loop (one PointModel for the group, no exception) maps each node's fields to a point
     // state, its volumetric strain to densities and its gradient to an increment, and the state back,

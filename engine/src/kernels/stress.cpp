@@ -116,21 +116,44 @@ void FirstPointFailure::record(std::size_t index, std::string message) {
     }
 }
 
+MaterialGroups group_by_material(const NodeStore& nodes, std::size_t real_count, std::size_t material_count) {
+    MaterialGroups groups;
+    if (real_count > 0 && std::all_of(nodes.material.begin(), nodes.material.begin() + static_cast<std::ptrdiff_t>(real_count),
+                                      [&](std::int32_t m) { return m == nodes.material[0]; })) {
+        groups.every_node_of = static_cast<std::size_t>(nodes.material[0]);
+        return groups;
+    }
+    groups.members.assign(material_count, {});
+    for (std::size_t i = 0; i < real_count; ++i) groups.members.at(static_cast<std::size_t>(nodes.material[i])).push_back(static_cast<NodeIndex>(i));
+    return groups;
+}
+
 template <class G>
 void update_stresses(NodeStore& nodes, std::size_t real_count, const std::vector<materials::Material>& materials,
                      const std::vector<std::vector<NodeIndex>>& groups, double dt, const StressPhaseOptions& options) {
+    MaterialGroups g;
+    g.members = groups;
+    update_stresses<G>(nodes, real_count, materials, g, dt, options);
+}
+
+template <class G>
+void update_stresses(NodeStore& nodes, std::size_t real_count, const std::vector<materials::Material>& materials,
+                     const MaterialGroups& groups, double dt, const StressPhaseOptions& options) {
     constexpr int D = G::dim;
     std::atomic<std::size_t> collapsed{no_collapsed_node};
     FirstPointFailure failure;  // taken only when a point update reports a fault
     const MaterialPointFields fields = material_point_fields(nodes, stress_components(nodes.dim()));
-    for (std::size_t m = 0; m < groups.size(); ++m) {
-        const materials::PointModel model(materials.at(m));  // the material's models, chosen once for its group
-        const auto& members = groups[m];
+    const std::size_t group_count = groups.every_node_of ? 1 : groups.members.size();
+    for (std::size_t m = 0; m < group_count; ++m) {
+        const std::size_t material = groups.every_node_of ? *groups.every_node_of : m;
+        const materials::PointModel model(materials.at(material));  // the material's models, chosen once for its group
+        const NodeIndex* members = groups.every_node_of ? nullptr : groups.members[m].data();  // null: node k is k
+        const std::size_t count = groups.every_node_of ? real_count : groups.members[m].size();
         // 64 points per task: a point update takes some 0.1-0.5 us, so a task is tens of microseconds
         // and a body of 10^3 nodes still splits among the threads (each point is its own).
-        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, members.size(), 64), [&](const tbb::blocked_range<std::size_t>& r) {
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, 64), [&](const tbb::blocked_range<std::size_t>& r) {
             for (std::size_t k = r.begin(); k != r.end(); ++k) {
-                const std::size_t i = members[k];
+                const std::size_t i = members ? members[k] : k;
                 if (i >= real_count) continue;
                 const double rate = nodes.volumetric_strain_rate[i];
                 const double density_old = nodes.mass[i] / nodes.volume[i];
@@ -223,5 +246,11 @@ template std::string point_fault_message<2>(const MaterialPointFields&, std::siz
                                             const materials::PointIncrement&, const materials::PointResult&);
 template std::string point_fault_message<3>(const MaterialPointFields&, std::size_t, const materials::PointModel&,
                                             const materials::PointIncrement&, const materials::PointResult&);
+template void update_stresses<PlaneStrain>(NodeStore&, std::size_t, const std::vector<materials::Material>&,
+                                           const MaterialGroups&, double, const StressPhaseOptions&);
+template void update_stresses<Axisymmetric>(NodeStore&, std::size_t, const std::vector<materials::Material>&,
+                                            const MaterialGroups&, double, const StressPhaseOptions&);
+template void update_stresses<ThreeD>(NodeStore&, std::size_t, const std::vector<materials::Material>&,
+                                      const MaterialGroups&, double, const StressPhaseOptions&);
 
 }  // namespace gpa

@@ -57,7 +57,7 @@ struct Simulation::Impl {
     std::size_t real = 0;
     GhostSet ghosts;
     RigidPlanes rigid_planes;  // reactions, impulses, the penetration guard (step/rigid_planes.hpp)
-    std::vector<std::vector<NodeIndex>> material_groups;
+    MaterialGroups material_groups;
     NeighbourLists neighbour_lists;  // lists, skin cache, scatter plan (step/neighbour_lists.hpp)
     Contact contact;                 // separation and sliding state (step/contact.hpp)
     Switching switching_part;        // connectivity modes and the switching phase (step/switching.hpp)
@@ -212,8 +212,7 @@ void Simulation::Impl::setup() {
 }
 
 void Simulation::Impl::regroup_materials() {
-    material_groups.assign(scene.materials.size(), {});
-    for (std::size_t i = 0; i < real; ++i) material_groups[static_cast<std::size_t>(nodes.material[i])].push_back(static_cast<NodeIndex>(i));
+    material_groups = group_by_material(nodes, real, scene.materials.size());
 }
 
 void Simulation::Impl::reorder() {
@@ -794,7 +793,7 @@ MemoryUse Simulation::memory_use() const {
     const auto& s = im.smoothing_scratch;
     add_memory(out, "smoothing: scratch", allocated_bytes(s.centre_change) + allocated_bytes(s.share) + allocated_bytes(s.total_change));
     std::size_t groups = 0;
-    for (const auto& g : im.material_groups) groups += allocated_bytes(g);
+    for (const auto& g : im.material_groups.members) groups += allocated_bytes(g);
     add_memory(out, "stress: material groups", groups);
     return out;
 }

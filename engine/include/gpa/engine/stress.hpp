@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <mutex>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -29,11 +30,26 @@ struct StressPhaseOptions {
     bool left_cauchy_green = false;
 };
 
-// Advances nodes [0, real_count) over dt from the velocity gradient of the gradient phase.
-// `groups[m]` lists the nodes of material m (each node in exactly one group); the material's
-// models are chosen once per group (materials::PointModel). Throws NumericalError naming the node
-// when a volume collapses (V <= 0) or a point update reports a fault (the smallest such node, after
-// the loop, with the update's words; that node is left as it was).
+// The real nodes of each material, for update_stresses: `members[m]` lists the nodes of material m
+// (each node in exactly one list), or, where every node [0, real_count) is of one material (most
+// scenes), `every_node_of` names it and there are no lists (4 bytes per node).
+struct MaterialGroups {
+    std::vector<std::vector<NodeIndex>> members;
+    std::optional<std::size_t> every_node_of;
+};
+
+// The groups of nodes [0, real_count) by their material (NodeStore::material).
+MaterialGroups group_by_material(const NodeStore& nodes, std::size_t real_count, std::size_t material_count);
+
+// Advances nodes [0, real_count) over dt from the velocity gradient of the gradient phase. The
+// models of each material are chosen once for its group (materials::PointModel). Throws
+// NumericalError naming the node when a volume collapses (V <= 0) or a point update reports a fault
+// (the smallest such node, after the loop, with the update's words; that node is left as it was).
+// Each node's update is its own, so how the nodes are grouped changes no result.
+template <class G>
+void update_stresses(NodeStore& nodes, std::size_t real_count, const std::vector<materials::Material>& materials,
+                     const MaterialGroups& groups, double dt, const StressPhaseOptions& options);
+// The same with a list of the nodes of each material, `groups[m]`.
 template <class G>
 void update_stresses(NodeStore& nodes, std::size_t real_count, const std::vector<materials::Material>& materials,
                      const std::vector<std::vector<NodeIndex>>& groups, double dt, const StressPhaseOptions& options);
