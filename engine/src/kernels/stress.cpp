@@ -203,17 +203,15 @@ void update_stresses(NodeStore& nodes, std::size_t real_count, const std::vector
     }
     if (failure.any()) {
         const std::size_t i = failure.index();
-        throw NumericalError(fmt::format("node {} at ({:.6g}, {:.6g}) m, material \"{}\", t-step {:.3g} s: {}", i,
-                                         nodes.position[0][i], nodes.position[1][i],
+        throw NumericalError(fmt::format("{}, material \"{}\", t-step {:.3g} s: {}", describe_node(nodes, i),
                                          materials.at(static_cast<std::size_t>(nodes.material[i])).name, dt, failure.message()),
                              i, "stress (material point update)");
     }
     if (const std::size_t i = collapsed.load(); i != no_collapsed_node) {
         throw NumericalError(fmt::format(
-            "node {} at ({:.6g}, {:.6g}) m collapsed: its volume would become {:.3g} m^3 (volumetric strain "
+            "{} collapsed: its volume would become {:.3g} m^3 (volumetric strain "
             "rate {:.3g} 1/s over dt = {:.3g} s); the time step is too large or the node was crushed",
-            i, nodes.position[0][i], nodes.position[1][i],
-            nodes.initial_volume[i] * (1.0 + advance_volumetric_strain(nodes.volumetric_strain[i], nodes.volumetric_strain_rate[i], dt)),
+            describe_node(nodes, i), nodes.initial_volume[i] * (1.0 + advance_volumetric_strain(nodes.volumetric_strain[i], nodes.volumetric_strain_rate[i], dt)),
             nodes.volumetric_strain_rate[i], dt),
             i, "volume");
     }

@@ -180,9 +180,7 @@ void NodeStore::permute(std::span<const NodeIndex> new_to_old) {
     permute_rows(fixed_mirrors, &fixed_mirror_planes, new_to_old, old_to_new);
 }
 
-namespace {
-
-std::string where(const NodeStore& nodes, std::size_t i) {
+std::string describe_node(const NodeStore& nodes, std::size_t i) {
     if (nodes.dim() == 3) {
         return fmt::format("node {} at (x, y, z) = ({:.6g}, {:.6g}, {:.6g}) m", i, nodes.position[0][i],
                            nodes.position[1][i], nodes.position[2][i]);
@@ -190,8 +188,6 @@ std::string where(const NodeStore& nodes, std::size_t i) {
     return fmt::format("node {} at (x, z) = ({:.6g}, {:.6g}) m", i, nodes.position[0][i],
                        nodes.position[1][i]);
 }
-
-}  // namespace
 
 void validate_nodes(const NodeStore& nodes, std::size_t first, std::size_t last) {
     const int d = nodes.dim();
@@ -203,19 +199,19 @@ void validate_nodes(const NodeStore& nodes, std::size_t first, std::size_t last)
             }
             if (!std::isfinite(nodes.velocity[c][i])) {
                 throw InputError(fmt::format("{}: velocity component {} is {} (must be finite)",
-                                             where(nodes, i), c, nodes.velocity[c][i]));
+                                             describe_node(nodes, i), c, nodes.velocity[c][i]));
             }
         }
         if (nodes.geometry() == GeometryKind::Axisymmetric && !(nodes.position[0][i] > 0.0)) {
             throw InputError(fmt::format(
                 "{}: an axisymmetric node must have radius x > 0 (Eq. 4 and 9 are singular on the "
                 "axis)",
-                where(nodes, i)));
+                describe_node(nodes, i)));
         }
         const auto positive = [&](const std::vector<double>& field, const char* name) {
             if (!(field[i] > 0.0) || !std::isfinite(field[i])) {
                 throw InputError(fmt::format("{}: {} is {} (must be positive and finite)",
-                                             where(nodes, i), name, field[i]));
+                                             describe_node(nodes, i), name, field[i]));
             }
         };
         positive(nodes.mass, "mass");

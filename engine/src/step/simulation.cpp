@@ -360,10 +360,9 @@ void Simulation::Impl::time_step() {
         for (std::size_t i = 0; i < real; ++i) {
             const double local = nodes.stable_length[i] / nodes.sound_speed[i];
             if (std::isnan(local)) {
-                throw NumericalError(fmt::format("node {} at ({:.6g}, {:.6g}) m at t = {:.6g} s: its stable time step is not "
+                throw NumericalError(fmt::format("{} at t = {:.6g} s: its stable time step is not "
                                                  "a number (stable length {}, sound speed {}, volume {})",
-                                                 i, nodes.position[0][i], nodes.position[1][i], time,
-                                                 nodes.stable_length[i], nodes.sound_speed[i], nodes.volume[i]),
+                                                 describe_node(nodes, i), time, nodes.stable_length[i], nodes.sound_speed[i], nodes.volume[i]),
                                      i, "stable time step");
             }
         }

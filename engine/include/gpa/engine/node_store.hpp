@@ -9,6 +9,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "gpa/engine/compressed_rows.hpp"
@@ -138,6 +139,9 @@ private:
     bool carries_reference_ = false;
     bool carries_shear_ = true;
 };
+
+// "node i at (x, z) = (...) m", or (x, y, z) in 3D: where an error message places a node.
+std::string describe_node(const NodeStore& nodes, std::size_t i);
 
 // Checks what the method cannot work with, for nodes [first, last): a non-finite or (in
 // axisymmetric geometry) non-positive radial coordinate, a non-positive mass, volume, size
