@@ -54,6 +54,7 @@ Block sheared_block(const std::vector<std::pair<std::size_t, double>>& compresse
         b.groups[0].push_back(static_cast<NodeIndex>(i));
         b.nodes.velocity_gradient[1][i] = 1e5;  // dv_x/dz
         b.nodes.smallest_h[i] = 1e-3;
+        b.nodes.stable_length[i] = 1.47e-3;  // l / h of a lattice node at a = 1 (kernels.hpp, carried_viscosity_fraction)
     }
     for (const auto& [i, rate] : compressed) b.nodes.volumetric_strain_rate[i] = rate;
     return b;
@@ -133,6 +134,37 @@ TEST(StressPhase, OneMaterialNeedsNoListOfItsNodesAndGivesTheSameBits) {
     for (std::size_t m = 0; m < 2; ++m) {
         for (NodeIndex i : lists.members[m]) EXPECT_EQ(two.nodes.material[i], static_cast<std::int32_t>(m));
     }
+}
+
+// The nodal viscosity a step can carry (kernels.hpp, carried_viscosity_fraction): a node whose
+// neighbours resolve h keeps Eq. 36 to the bit, however hard it is compressed short of a shock
+// whose viscous signal speed rivals sound; a node run into a neighbour (its stable length l a
+// hundredth of h) is given the Q for which dt nu / l^2 is 1, nu = C_L c h + 2 C_Q h^2 |eps_v_dot|
+// its viscosity's kinematic size, where Eq. 36 would make that product about 160 and the update
+// overshoot the node's motion many times over.
+TEST(StressPhase, ANodeRunIntoItsNeighbourGetsTheViscosityItsStepCanCarry) {
+    constexpr double dt = 1e-8, rate = -1e5;  // 0.1 % of volume per step
+    constexpr std::size_t lattice_node = 40, close_node = 41;
+    Block b = sheared_block({{lattice_node, rate}, {close_node, rate}});
+    b.nodes.stable_length[close_node] = 1e-5;
+    const StressPhaseOptions options;  // nodal viscosity, C_L 0.2, C_Q 4
+    const std::vector<double> sound{b.nodes.sound_speed[lattice_node], b.nodes.sound_speed[close_node]};
+    update_stresses<PlaneStrain>(b.nodes, b.nodes.size(), b.materials, b.groups, dt, options);
+    const auto eq36 = [&](std::size_t i, double c) {
+        return nodal_viscosity(rate, b.nodes.mass[i] / b.nodes.volume[i], c, b.nodes.smallest_h[i], options.viscosity_linear,
+                               options.viscosity_quadratic);
+    };
+    const double q_lattice = eq36(lattice_node, sound[0]);
+    ASSERT_GT(q_lattice, 0.0);
+    EXPECT_EQ(b.nodes.viscous_pressure[lattice_node], q_lattice);
+    const double nu = nodal_viscosity_diffusivity(rate, sound[1], 1e-3, options.viscosity_linear, options.viscosity_quadratic);
+    const double l = 1e-5;
+    ASSERT_GT(dt * nu / (l * l), 100.0) << "Eq. 36 alone must overshoot here";
+    const double carried = b.nodes.viscous_pressure[close_node] / eq36(close_node, sound[1]);
+    // The product dt nu / l^2 of the viscosity applied: the bound, to round-off.
+    EXPECT_NEAR(dt * carried * nu / (l * l), nodal_viscosity_step_limit, 1e-12);
+    // A stable length far above what the step needs leaves Eq. 36 as it is: the factor never exceeds 1.
+    EXPECT_EQ(carried_viscosity_fraction(nu, 1.0, dt), 1.0);
 }
 
 // A node whose volume one step would take to zero or below stops the step, named with its index

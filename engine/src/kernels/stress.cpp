@@ -167,11 +167,19 @@ void update_stresses(NodeStore& nodes, std::size_t real_count, const std::vector
                     continue;
                 }
                 const double density_new = nodes.mass[i] / volume;
-                // Eq. 36: nodal viscosity from this step's volumetric strain rate.
-                const double q_new = options.nodal_viscosity
-                                         ? nodal_viscosity(rate, density_new, nodes.sound_speed[i], nodes.smallest_h[i],
-                                                           options.viscosity_linear, options.viscosity_quadratic)
-                                         : 0.0;
+                // Eq. 36: nodal viscosity from this step's volumetric strain rate, limited to what
+                // its explicit update over this step can carry (kernels.hpp, carried_viscosity_fraction).
+                double q_new = 0.0;
+                if (options.nodal_viscosity) {
+                    const double h = nodes.smallest_h[i];
+                    q_new = nodal_viscosity(rate, density_new, nodes.sound_speed[i], h, options.viscosity_linear,
+                                            options.viscosity_quadratic);
+                    if (q_new > 0.0) {
+                        q_new *= carried_viscosity_fraction(nodal_viscosity_diffusivity(rate, nodes.sound_speed[i], h, options.viscosity_linear,
+                                                                                        options.viscosity_quadratic),
+                                                            nodes.stable_length[i], dt);
+                    }
+                }
                 materials::PointIncrement inc;
                 inc.velocity_gradient = full_velocity_gradient<G>(nodes, i);
                 inc.dt = dt;

@@ -281,6 +281,33 @@ inline double nodal_viscosity(double volumetric_strain_rate, double density, dou
     return density * (c_linear * sound_speed * (-hr) + c_quadratic * hr * hr);
 }
 
+// Eq. 36 limited to what its explicit update can carry (spec section 6; docs/energy.md, "[spec] The
+// nodal viscosity a step can carry"). About the node's rate the viscosity is a bulk viscosity of
+// kinematic size nu = dQ / d|eps_v_dot| / rho = C_L c h + 2 C_Q h^2 |eps_v_dot|, which damps the
+// node's stiffest mode (frequency about c / l, l its stable length) at a rate of about nu / l^2.
+// The stress phase applies this step's Q over the step dt, so once dt nu / l^2 passes about 2 each
+// step overshoots by more than the last and the viscosity pumps the mode instead of damping it
+// (measured: two nodes of a 3D impact face 1.3 um apart, l = 30 um against h = 0.44 mm, their
+// amplitude doubling every three steps; a debris node 0.88 mm across 2.4 um from a neighbour,
+// dt nu / l^2 = 200, giving back 3.8 J of the 4.2 J of viscous work of a 4 km/s impact in one step).
+// The paper's step l / (c + sqrt(Q / rho)) does not see this where l << h. The factor below scales
+// Q so that dt nu / l^2 <= 1: half the limit, the node's mode damped within the step without being
+// reversed. A node whose neighbours resolve h (l >= h: every node of an undisturbed lattice) takes
+// the step dt <= C_cfl l / (c + sqrt(Q / rho)), so that dt nu / l^2 <= C_cfl (C_L + 2 sqrt(C_Q) s) /
+// (1 + s) with s = sqrt(Q / rho) / c: with the paper's C_L = 0.2, C_Q = 4 at C_cfl 0.4, 0.08 where
+// sound sets the step, 0.84 at s = 1, and 1 only once the viscosity's own signal speed passes 1.5 c.
+// So Eq. 36 stands on such nodes, and the factor acts on nodes run together and on debris grown
+// many times its neighbours' size. dt: the step the stress update advances.
+inline double nodal_viscosity_diffusivity(double volumetric_strain_rate, double sound_speed, double smallest_h, double c_linear,
+                                          double c_quadratic) {
+    return c_linear * sound_speed * smallest_h + 2.0 * c_quadratic * smallest_h * smallest_h * std::abs(volumetric_strain_rate);
+}
+inline constexpr double nodal_viscosity_step_limit = 1.0;  // the bound on dt nu / l^2 above
+inline double carried_viscosity_fraction(double diffusivity, double stable_length, double dt) {
+    const double carried = nodal_viscosity_step_limit * stable_length * stable_length;
+    return dt * diffusivity > carried ? carried / (dt * diffusivity) : 1.0;
+}
+
 // Spec section 11, step 7: a node's stable time step h / (c + sqrt(Q / rho) + w), with h its
 // smallest h_ij (its stable length), c its longitudinal sound speed, Q its viscous pressure (the
 // larger of the nodal and its largest bond viscosity; negative taken as 0) and w the closing speed
