@@ -129,12 +129,12 @@ TEST(HypervelocitySpall, FragmentsOfTheAllVariableRunAtFineResolutionGainNoKinet
 
 // The nodal viscosity only dissipates: what it books may dip by the lag of an explicit update,
 // never give back a sizable part of what it took. In scenes/hypervelocity-small.toml (the paper's
-// small projectile at 4 km/s), at 1.47 us a failed debris node grown to 0.88 mm (smallest h_ij
-// 0.57 mm) ran into a neighbour 2.4 um away: over h its viscosity damped the pair at about
-// 200 / dt, the update overshot, and in one step the viscous work fell from 4.15 J to 1.16 J while
-// the kinetic energy rose from 10.3 J to 13.7 J (of 18.0 J given), the energy balance closed to
-// round-off. With the viscosity limited to what a step can carry (kernels.hpp,
-// carried_viscosity_fraction) no step gives any back.
+// small projectile at 4 km/s), at 1.47 us (step 476) a failed debris node grown to 0.88 mm (smallest
+// h_ij 0.57 mm) ran into a neighbour 2.4 um away (its stable length 40 um): over h its viscosity
+// damped the pair at about 100 / dt, the update overshot, and that step gave back 3.82 J of the
+// 4.16 J of viscous work booked so far while the kinetic energy rose from 10.3 J to 13.7 J (of 18.0
+// J given), the energy balance closed to round-off. With the viscosity limited to what a step can
+// carry (kernels.hpp, carried_viscosity_fraction) no step gives back more than a step books.
 TEST(HypervelocitySmall, DebrisRunningTogetherGetsNoWorkBackFromTheViscosity) {
     Scene s = io::load_scene(std::string(GPA_SOURCE_DIR) + "/scenes/hypervelocity-small.toml");
     s.stop.end_time = 1.6e-6;  // past the event (step 476 of the run before the fix)
@@ -155,8 +155,8 @@ TEST(HypervelocitySmall, DebrisRunningTogetherGetsNoWorkBackFromTheViscosity) {
         largest_gain = std::max(largest_gain, change);
         previous = w;
     }
-    std::printf("[ measured ] viscous work %.4f J at %.3f us; one step's largest gain %.3g J and largest fall %.3g J; the worst fall "
-                "%.3g times the largest gain before it (at %.4f us); %zu steps\n",
+    std::printf("[ measured ] viscous work %.4f J at %.3f us; one step's largest gain %.3g J and largest fall %.3g J; "
+                "the worst fall %.3g times the largest gain before it (at %.4f us); %zu steps\n",
                 previous, sim.time() * 1e6, largest_gain, largest_fall, worst_ratio, at * 1e6, sim.steps());
     ASSERT_GT(previous, 1.0) << "the viscosity must have worked (4 J by 1.6 us)";
     // Measured with the limit: 0.16 (a fall of 0.028 J at 0.25 us against a gain of 0.17 J); the

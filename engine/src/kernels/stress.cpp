@@ -175,9 +175,9 @@ void update_stresses(NodeStore& nodes, std::size_t real_count, const std::vector
                     q_new = nodal_viscosity(rate, density_new, nodes.sound_speed[i], h, options.viscosity_linear,
                                             options.viscosity_quadratic);
                     if (q_new > 0.0) {
-                        q_new *= carried_viscosity_fraction(nodal_viscosity_diffusivity(rate, nodes.sound_speed[i], h, options.viscosity_linear,
-                                                                                        options.viscosity_quadratic),
-                                                            nodes.stable_length[i], dt);
+                        const double nu = nodal_viscosity_diffusivity(rate, nodes.sound_speed[i], h, options.viscosity_linear,
+                                                                      options.viscosity_quadratic);
+                        q_new *= carried_viscosity_fraction(nu, nodes.stable_length[i], dt);
                     }
                 }
                 materials::PointIncrement inc;

@@ -289,7 +289,7 @@ inline double nodal_viscosity(double volumetric_strain_rate, double density, dou
 // step overshoots by more than the last and the viscosity pumps the mode instead of damping it
 // (measured: two nodes of a 3D impact face 1.3 um apart, l = 30 um against h = 0.44 mm, their
 // amplitude doubling every three steps; a debris node 0.88 mm across 2.4 um from a neighbour,
-// dt nu / l^2 = 200, giving back 3.8 J of the 4.2 J of viscous work of a 4 km/s impact in one step).
+// dt nu / l^2 near 100, giving back 3.8 J of the 4.2 J of viscous work of a 4 km/s impact in one step).
 // The paper's step l / (c + sqrt(Q / rho)) does not see this where l << h. The factor below scales
 // Q so that dt nu / l^2 <= 1: half the limit, the node's mode damped within the step without being
 // reversed. A node whose neighbours resolve h (l >= h: every node of an undisturbed lattice) takes
