@@ -110,12 +110,72 @@ TEST(LocalPeak, AUniformFieldIsItsOwnPeakAndASpikeIsAveraged) {
     EXPECT_EQ(spike.raw, 11.0);
     EXPECT_NEAR(spike.position[0], 1.05, 1e-15);
     EXPECT_NEAR(spike.position[1], 1.05, 1e-15);
-    // A point of another body is not in the neighbourhood: alone in its body, its mean is itself.
+    // A point of another body is not in the neighbourhood: alone in its body, it has no
+    // neighbourhood mean and no part in the peak; it is still the largest single value.
     points[10 * 20 + 11].body = 1;
     points[10 * 20 + 11].value = 100.0;
-    EXPECT_NEAR(measure::local_peak(points, 0.12, 2).value, 100.0, 1e-12);
+    const auto with_lone = measure::local_peak(points, 0.12, 2);
+    EXPECT_EQ(with_lone.alone, 1u);
+    EXPECT_EQ(with_lone.raw, 100.0);
+    // The spike's neighbourhood lost the point at (1.05, 1.15) (now of body 1): (11 + 3 x 2) / 4.
+    EXPECT_NEAR(with_lone.value, 17.0 / 4.0, 1e-13);
+    EXPECT_NEAR(with_lone.position[0], 1.05, 1e-15);
+    EXPECT_NEAR(with_lone.position[1], 1.05, 1e-15);
+    EXPECT_TRUE(with_lone.has_peak());
     EXPECT_THROW(measure::local_peak(points, 0.0, 2), std::invalid_argument);
     EXPECT_THROW(measure::local_peak(points, NAN, 2), std::invalid_argument);
+}
+
+TEST(LocalPeak, ADebrisNodeAloneIsNoNeighbourhoodAndMakesNoPeak) {
+    // A block of 10 x 10 points at 1 (spacing 0.1), and one node of the same body flown 1 away
+    // with the largest value, 7: within a radius of 0.2 it has no other point, so its "mean"
+    // would be its own 7. The peak stays the block's 1; the largest single value is the node's.
+    std::vector<measure::FieldPoint> points;
+    for (int i = 0; i < 10; ++i) {
+        for (int k = 0; k < 10; ++k) {
+            measure::FieldPoint p;
+            p.position = {0.1 * i, 0.1 * k, 0.0};
+            p.weight = 0.01;
+            p.value = 1.0;
+            points.push_back(p);
+        }
+    }
+    measure::FieldPoint debris;
+    debris.position = {2.0, 0.5, 0.0};
+    debris.weight = 0.01;
+    debris.value = 7.0;
+    points.push_back(debris);
+    for (int dim : {2, 3}) {
+        const auto peak = measure::local_peak(points, 0.2, dim);
+        EXPECT_EQ(peak.points, 101u);
+        EXPECT_EQ(peak.alone, 1u);
+        EXPECT_NEAR(peak.value, 1.0, 1e-15) << dim;
+        EXPECT_EQ(peak.raw, 7.0);
+        EXPECT_EQ(peak.raw_position[0], 2.0);
+        // A second node beside it (0.15 away): two points are a neighbourhood, mean (7 + 5) / 2.
+        std::vector<measure::FieldPoint> pair = points;
+        debris.position = {2.15, 0.5, 0.0};
+        debris.value = 5.0;
+        pair.push_back(debris);
+        const auto two = measure::local_peak(pair, 0.2, dim);
+        EXPECT_EQ(two.alone, 0u);
+        EXPECT_NEAR(two.value, 6.0, 1e-15);
+        debris.value = 7.0;
+    }
+    // Points all alone (spacing 1, radius 0.2): no neighbourhood anywhere, no peak (NaN), not
+    // the largest single value passed off as a mean.
+    std::vector<measure::FieldPoint> scattered(5);
+    for (int k = 0; k < 5; ++k) {
+        scattered[k].position = {1.0 * k, 0.0, 0.0};
+        scattered[k].weight = 0.01;
+        scattered[k].value = k;
+    }
+    const auto none = measure::local_peak(scattered, 0.2, 2);
+    EXPECT_EQ(none.alone, 5u);
+    EXPECT_FALSE(none.has_peak());
+    EXPECT_TRUE(std::isnan(none.value));
+    EXPECT_TRUE(std::isnan(none.position[0]));
+    EXPECT_EQ(none.raw, 4.0);
 }
 
 TEST(LocalPeak, SeveralFieldsInOnePassAreEachFieldsOwnPeakExactly) {

@@ -491,7 +491,7 @@ std::map<std::string, double> run_metrics(const Simulation& sim) {
         m["final_length"] = t.length;
         m["footprint_diameter"] = t.footprint_diameter;
     }
-    if (t.local.measured && t.local.plastic_strain.points > 0) {
+    if (t.local.measured && t.local.plastic_strain.has_peak()) {
         m["peak_plastic_strain"] = t.local.plastic_strain.value;
         m["peak_temperature"] = t.local.temperature.value;
         m["peak_radius"] = t.local.radius;
@@ -577,8 +577,10 @@ void write_summary(const fs::path& file, const Simulation& sim, const RunSummary
                                json_number(p.raw), raw_at);
         };
         field("local", fmt::format("{{\"radius_m\": {}, \"plastic_strain\": {}, \"temperature_K\": {}, "
+                                   "\"points\": {}, \"points_alone\": {}, "
                                    "\"face_plastic_strain_roughness\": {}, \"face_points\": {}}}",
                                    json_number(t.local.radius), peak(t.local.plastic_strain), peak(t.local.temperature),
+                                   t.local.plastic_strain.points, t.local.plastic_strain.alone,
                                    json_number(t.local.face_roughness), t.local.face_points));
     }
     field("energy", fmt::format("{{\"initial_J\": {}, \"kinetic_J\": {}, \"internal_J\": {}, \"plastic_work_J\": {}, "

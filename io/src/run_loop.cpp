@@ -777,12 +777,20 @@ std::string run_report(const Simulation& sim) {
         fmt::format_to(std::back_inserter(out), "  {}: {:.4g} against the reference {:.4g} ({:+.2f} %)\n", c.key, c.computed, c.reference,
                    100.0 * c.relative_error);
     }
-    if (t.local.measured && t.local.plastic_strain.points > 0) {
+    if (t.local.measured && t.local.plastic_strain.has_peak()) {
         const auto& at = t.local.plastic_strain.position;
         const std::string where = dim == 3 ? fmt::format("(x, y, z) = ({:.3g}, {:.3g}, {:.3g}) mm", at[0] * 1e3, at[1] * 1e3, at[2] * 1e3)
                                            : fmt::format("(x, z) = ({:.3g}, {:.3g}) mm", at[0] * 1e3, at[1] * 1e3);
         fmt::format_to(std::back_inserter(out), "  peak plastic strain {:.4g} (mean within {:.3g} mm) at {}, largest single value {:.4g}; peak temperature {:.4g} K\n",
                    t.local.plastic_strain.value, t.local.radius * 1e3, where, t.local.plastic_strain.raw, t.local.temperature.value);
+    }
+    if (t.local.measured && t.local.plastic_strain.alone > 0) {
+        // Nodes with no other point of their body within the radius (debris) have no neighbourhood
+        // mean: left out of the peaks, counted in the largest single values.
+        fmt::format_to(std::back_inserter(out), "  {} of {} material points alone within {:.3g} mm (debris): not in the peaks{}\n",
+                       t.local.plastic_strain.alone, t.local.plastic_strain.points, t.local.radius * 1e3,
+                       t.local.plastic_strain.has_peak() ? "" : fmt::format(" (none has a neighbourhood: no peak; largest single value {:.4g})",
+                                                                            t.local.plastic_strain.raw));
     }
     if (!sim.scene().element_reference.empty()) {
         try {

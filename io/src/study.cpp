@@ -546,7 +546,7 @@ std::map<std::string, double> RunProbe::metrics(const Simulation& sim) const {
                                     {"energy_error", t.energy_error},
                                     {"variable_fraction", static_cast<double>(t.variable_nodes) / static_cast<double>(t.real_nodes)},
                                     {"hourglass_work", t.hourglass_work}};
-    if (t.local.measured && t.local.plastic_strain.points > 0) {
+    if (t.local.measured && t.local.plastic_strain.has_peak()) {
         m["peak_plastic_strain"] = t.local.plastic_strain.value;
         m["peak_temperature"] = t.local.temperature.value;
         m["peak_radius"] = t.local.radius;  // not a study metric: tells the reference comparison the neighbourhood

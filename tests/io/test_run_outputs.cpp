@@ -136,6 +136,7 @@ TEST(Summary, PlaneStrainKeysOfExtensiveQuantitiesArePerMetre) {
     for (const bool plane_strain : {false, true}) {
         Simulation sim(parse_scene(plane_strain ? slab : tiny_scene, "s.toml"), 1);
         sim.step();
+        sim.measure_bodies();  // the local peaks below
         write_summary(dir / "summary.json", sim, RunSummary{});
         const std::string text = read_all(dir / "summary.json");
         for (const char* key : {"mass_kg", "kinetic_energy_J", "plastic_work_J", "kinetic_J", "reaction_N", "momentum_kg_m_s"}) {
@@ -150,6 +151,10 @@ TEST(Summary, PlaneStrainKeysOfExtensiveQuantitiesArePerMetre) {
         EXPECT_NE(text.find(fmt::format("\"row_searches\": {}", sim.totals().row_searches)), std::string::npos) << text;
         EXPECT_NE(text.find(fmt::format("\"rows_searched\": {}", sim.totals().rows_searched)), std::string::npos) << text;
         EXPECT_GE(sim.totals().neighbour_searches, 1u);
+        // The local peaks say over how many points they were taken and how many had no
+        // neighbourhood (measure.hpp, LocalPeak::alone): none in a body at rest on its lattice.
+        EXPECT_NE(text.find(fmt::format("\"points\": {}, \"points_alone\": 0", sim.real_count())), std::string::npos)
+            << text;
     }
     fs::remove_all(dir);
 }

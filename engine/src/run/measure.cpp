@@ -153,6 +153,7 @@ std::vector<LocalPeak> local_peaks(std::span<const FieldPoint> points, std::span
     // mean_f(p) = sum_q w_q f_q / sum_q w_q, summed over the neighbour cells in a fixed order (x
     // slowest), each cell's points in index order: the same order for every field and thread count.
     std::vector<double> mean(n * nf, 0.0);
+    std::vector<std::uint8_t> alone(n, 0);  // no other point of the body within the radius
     const double r2 = radius * radius;
     // The points' coordinates, weights and values copied in `order`, so that a cell's points are
     // read as contiguous runs.
@@ -188,6 +189,7 @@ std::vector<LocalPeak> local_peaks(std::span<const FieldPoint> points, std::span
             for (std::size_t kp = cell_begin[cell]; kp < cell_begin[cell + 1]; ++kp) {
                 const std::size_t p = order[kp];
                 double sw = 0.0;
+                std::size_t inside_count = 0;  // the point itself included
                 std::fill(swf.begin(), swf.end(), 0.0);
                 for (int m = 0; m < near_count; ++m) {
                     const std::size_t other = near[static_cast<std::size_t>(m)];
@@ -203,23 +205,35 @@ std::vector<LocalPeak> local_peaks(std::span<const FieldPoint> points, std::span
                         const bool inside = !(d2 > r2);
                         const double w = weight[kq];
                         sw += inside ? w : -0.0;
+                        inside_count += inside;
                         for (std::size_t f = 0; f < nf; ++f) swf[f] += inside ? w * ordered_value[f * n + kq] : -0.0;
                     }
                 }
                 for (std::size_t f = 0; f < nf; ++f) mean[f * n + p] = sw > 0.0 ? swf[f] / sw : fields[f][p];
+                alone[p] = inside_count <= 1;
             }
         }
     });
+    // The peak over the points that have a neighbourhood (a lone point's "mean" is its own value,
+    // the quantity `raw` already reports); the largest single value over every point.
+    const std::size_t lone = static_cast<std::size_t>(std::count(alone.begin(), alone.end(), std::uint8_t{1}));
+    constexpr std::size_t none = std::numeric_limits<std::size_t>::max();
     for (std::size_t f = 0; f < nf; ++f) {
         const double* m = mean.data() + f * n;
         const std::span<const double> value = fields[f];
-        std::size_t best = 0, best_raw = 0;
-        for (std::size_t p = 1; p < n; ++p) {
-            if (m[p] > m[best]) best = p;
+        std::size_t best = none, best_raw = 0;
+        for (std::size_t p = 0; p < n; ++p) {
+            if (!alone[p] && (best == none || m[p] > m[best])) best = p;
             if (value[p] > value[best_raw]) best_raw = p;
         }
-        out[f].value = m[best];
-        out[f].position = points[best].position;
+        out[f].alone = lone;
+        if (best != none) {
+            out[f].value = m[best];
+            out[f].position = points[best].position;
+        } else {
+            out[f].value = std::numeric_limits<double>::quiet_NaN();
+            out[f].position.fill(std::numeric_limits<double>::quiet_NaN());
+        }
         out[f].raw = value[best_raw];
         out[f].raw_position = points[best_raw].position;
     }

@@ -228,6 +228,11 @@ struct LocalPeak {
     double raw = 0.0;                           // largest value at one point
     std::array<double, 3> raw_position{0, 0, 0};
     std::size_t points = 0;                     // points measured (0: no peak)
+    // Points whose neighbourhood holds no other point of their body (a node flown off as debris):
+    // their own value is no neighbourhood mean, so they take no part in `value` (they do in
+    // `raw`). When every point is alone, `value` and `position` are NaN: no peak.
+    std::size_t alone = 0;
+    bool has_peak() const { return points > alone; }
 };
 
 // The peak of `points` over neighbourhoods of `radius` (> 0) in `dim` (2 or 3) dimensions.
