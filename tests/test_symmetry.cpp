@@ -113,6 +113,10 @@ void expect_same_run(Simulation& share, Simulation& whole, int copies, int steps
     whole.measure_bodies();
     EXPECT_NEAR(share.totals().local.plastic_strain.value / whole.totals().local.plastic_strain.value, 1.0, round_off);
     EXPECT_NEAR(share.totals().local.plastic_strain.raw / whole.totals().local.plastic_strain.raw, 1.0, round_off);
+    // The peaks count the model's own points, not their mirror images (summary.json, `local`).
+    EXPECT_EQ(share.totals().local.plastic_strain.points, share.real_count());
+    EXPECT_EQ(whole.totals().local.plastic_strain.points, whole.real_count());
+    EXPECT_EQ(share.totals().local.plastic_strain.alone, 0u);
     EXPECT_EQ(symmetry_copies(share.scene(), 0), copies);
     EXPECT_EQ(symmetry_copies(whole.scene(), 0), 1);
 }

@@ -385,6 +385,13 @@ void Measures::local_fields(const Scene& scene, const NodeStore& nodes, std::siz
     const std::vector<measure::LocalPeak> peaks = measure::local_peaks(points, fields, out.radius, d);
     out.plastic_strain = peaks[0];
     out.temperature = peaks[1];
+    // The counts are the model's own points: each point and its images are alone or not together
+    // (the images are the whole body's mirror copies), so both counts divide by the copies.
+    const std::size_t copies = std::size_t{1} << mirrors.size();
+    for (measure::LocalPeak* peak : {&out.plastic_strain, &out.temperature}) {
+        peak->points /= copies;
+        peak->alone /= copies;
+    }
     out.face_roughness = measure::face_roughness(face_across, face_value);
     out.face_points = face_value.size();
 }

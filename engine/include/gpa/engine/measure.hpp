@@ -227,7 +227,7 @@ struct LocalPeak {
     std::array<double, 3> position{0, 0, 0};    // the point it is centred on
     double raw = 0.0;                           // largest value at one point
     std::array<double, 3> raw_position{0, 0, 0};
-    std::size_t points = 0;                     // points measured (0: no peak)
+    std::size_t points = 0;                     // points measured (0: no peak; Measures counts a model's own, not their mirror images)
     // Points whose neighbourhood holds no other point of their body (a node flown off as debris):
     // their own value is no neighbourhood mean, so they take no part in `value` (they do in
     // `raw`). When every point is alone, `value` and `position` are NaN: no peak.
