@@ -51,8 +51,7 @@ inline constexpr double kBulkModulusFloorFraction = 0.01;
 inline constexpr double kPoleMargin = 0.1;
 
 // Symmetric tensors: Sym3 (xx, yy, zz, yz, xz, xy) <-> 3x3 matrix. Inline, with von_mises: the
-// point update calls them for every point of every step (out of line, von_mises alone took 5 % of
-// an element run).
+// point update calls them for every point of every step.
 inline Eigen::Matrix3d to_matrix(const Sym3& s) {
     Eigen::Matrix3d m;
     m << s[0], s[5], s[4],  //

@@ -121,7 +121,7 @@ ReturnResult johnson_cook_return(const JohnsonCookStrength& jc, const Eigen::Mat
     // to k = 8, which leaves out at most |C(n, 9)| u^9 < 0.014 x 2^-63 = 1.5e-21 (0 < n <= 4), far
     // below a double's round-off, for a few products where std::pow took about as long as the rest
     // of an evaluation. Summed in Estrin's pairs (u, u^2, u^4), whose chain of dependent operations
-    // is a third of Horner's (point/NAME of gpa_bench_kernels: 4 % faster). At first yield
+    // is a third of Horner's. At first yield
     // (eps_p = 0), for larger u or n: std::pow.
     const bool series = strain_power > 0.0 && jc.n <= 4.0;
     const double inverse_strain = series ? 1.0 / plastic_strain : 0.0;

@@ -31,7 +31,7 @@ void record_smallest(std::atomic<std::size_t>& slot, std::size_t i) {
 }
 
 // Every entry of a small fixed-size matrix finite, tested entry by entry without a branch (Eigen's
-// allFinite compares (m - m) with itself through a call that was 1 % of the main job's step).
+// allFinite compares (m - m) with itself through a function call per centre).
 template <class M>
 bool all_finite(const M& m) {
     bool finite = true;

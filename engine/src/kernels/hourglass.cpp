@@ -146,8 +146,8 @@ struct CentreFit {
     bool found = false;  // false: no fit (too few pairs, or all on a line)
 
     // The part of a pair's difference the fit does not follow (kernels.hpp, e_ij), with the second
-    // derivatives or without: the callers choose once per centre, so that the affine loop is the
-    // one it was (a branch per pair and the curvature's registers slowed the 3D force pass by 10 %).
+    // derivatives or without: the callers choose once per centre, so that the affine loop carries
+    // neither a branch per pair nor the curvature's registers.
     template <bool Curved>
     Vec<D> error(const Vec<D>& offset, const Vec<D>& difference) const {
         if constexpr (Curved) {
@@ -230,10 +230,10 @@ std::array<CentreFit<D>, 2> quadratic_centre_fits(const QuadraticHourglassFit<D>
 
 // One centre of the control (hourglass.hpp, hourglass_centre). `General` false: the affine fit
 // and the stiffness on fixed centres only, HourglassFields::quadratic and reference_position
-// ignored; that instantiation is the control of the defaults, which the options below leave as it
-// was (compiled inside one function with them, their state and branches slowed its force pass by
-// 12-31 % and its booking by 18-49 %). `General` true: the quadratic fit when asked for, and the
-// stiffness on flowing centres against their relaxing reference.
+// ignored; that instantiation is the control of the defaults, kept free of the options' state
+// and branches, which slowed it when compiled in (docs/performance.md, "Figures that were kept in
+// code comments"). `General` true: the quadratic fit when asked for, and the stiffness on flowing
+// centres against their relaxing reference.
 template <int D, bool General>
 HourglassPower centre_control(std::span<const NodeIndex> row, std::size_t i, const HourglassFields<D>& f,
                               std::size_t real_count, double coefficient) {

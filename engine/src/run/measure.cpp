@@ -34,9 +34,9 @@ struct CellHash {
 // cell_begin[k] where the k-th occupied cell starts in it (one past the last: the point count).
 // Where the cells of the points' bounding box are few (at most four per point), a counting sort
 // over the box's cells numbered body first, then x, y, z, and a table from box cell to occupied
-// cell: the order std::sort and a hash map gave, without their comparisons and look-ups (the local
-// peaks of every history row were 3.7 % of the README main job on 1 thread). Elsewhere (a
-// fragment flown far from its body), the sort and the hash map.
+// cell: the order std::sort and a hash map gave, without their comparisons and look-ups (this runs
+// at every history row). Elsewhere (a fragment flown far from its body), the sort and the hash
+// map.
 struct CellGrid {
     static constexpr std::size_t none = std::numeric_limits<std::size_t>::max();
     std::vector<std::size_t> order, cell_begin;

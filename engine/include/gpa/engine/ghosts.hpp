@@ -219,8 +219,8 @@ private:
     // The ghosts of each node of sources_sorted_, one per mask slot (ghost node, or -1 where the
     // node has none across that combination): masks_.size() entries per source, in the order of
     // sources_sorted_. Per source, not per real node, so that it takes memory in proportion to
-    // the ghosts (a table per real node took 4 bytes per node and combination: 12 in a 2D bar on
-    // an anvil, 28 in a 3D quarter). table_real_count_: the real nodes of the build it describes.
+    // the ghosts, not to the nodes times the plane combinations. table_real_count_: the real nodes
+    // of the build it describes.
     std::vector<std::int32_t> ghost_table_;
     std::size_t table_real_count_ = 0;
     // The ghost of real node `node` across the combination of slot `slot`, or -1 (a binary search

@@ -128,8 +128,7 @@ inline bool controlled_hourglass_pair(const HourglassFields<D>& f, std::size_t i
 // F_j . (w_j - w_i) at power_velocity. The same numbers, in the same order, as hourglass_centre's
 // own walk of the row, which uses it too. `Curved`: the fit may have second derivatives
 // (HourglassFields::quadratic; kept zero where the affine fit served); the pass chooses it once, so
-// that the affine walk carries neither the curvature's registers nor a branch per pair (both slowed
-// the booking pass by a fifth to a half when they were there at run time).
+// that the affine walk carries neither the curvature's registers nor a branch per pair.
 template <int D, bool Curved = false>
 class KeptDampingPower {
 public:
