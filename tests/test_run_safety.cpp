@@ -144,10 +144,11 @@ TEST(MemoryLimit, NodesBeyondItAreRefusedBeforeTheyAreMade) {
     EXPECT_GT(estimated_node_count(scene), 1e12);
 }
 
-TEST(MemoryLimit, NeighbourListsAreCheckedBeforeASearchAllocatesThem) {
+TEST(MemoryLimit, NeighbourListsAreCheckedAsASearchMakesThem) {
     // At the largest influence distance the lists hold about twice the pairs per node that the
     // set-up estimate assumes: a limit just above that estimate passes set-up's check of the
-    // nodes and refuses the first search (in set-up), before its lists are allocated.
+    // nodes and refuses the first search (in set-up) at the wave of rows that takes its entries
+    // past the limit, before that wave is placed in the lists (find_neighbours).
     auto scene = testing::armco_cylinder(10, 40e-6);
     scene.solver.influence_distance = 1.5;
     const double nodes = estimated_node_count(scene);

@@ -5,6 +5,7 @@
 #include <random>
 
 #include <gtest/gtest.h>
+#include <tbb/task_arena.h>
 
 #include "gpa/engine/ghosts.hpp"
 #include "gpa/engine/memory_use.hpp"
@@ -293,6 +294,48 @@ TEST(Search, ResultDoesNotDependOnThreadCountOrScratchReuse) {
     find_neighbours(n, 1.0, n.size(), out, scratch);
     find_neighbours(n, 1.0, n.size(), out, scratch);
     EXPECT_EQ(out, reference);  // identical lists, identical order
+}
+
+// A search makes its rows in waves of blocks of 1024 centres (four blocks per thread or a
+// thirty-second of them, whichever is more): the lists must not depend on where the waves fall,
+// nor on how large the lists were before.
+TEST(Search, RowsMadeInWavesAreOneSearchWhateverTheThreadsAndTheListsBefore) {
+    // Diameters that grow with the index, so that the first wave's rows are the sparsest and the
+    // lists grow in the later waves: about 3 to 80 neighbours per node at a = 1.2.
+    auto n = random_cloud(GeometryKind::PlaneStrain, 40000, 11);
+    for (std::size_t i = 0; i < n.size(); ++i) n.diameter[i] *= 0.05 + 0.2 * static_cast<double>(i) / static_cast<double>(n.size());
+    const auto search_on = [&](int threads, double a, CompressedRows& out, NeighbourScratch& scratch) {
+        tbb::task_arena arena(threads);
+        arena.execute([&] { find_neighbours(n, a, n.size(), out, scratch); });
+    };
+    // 40 blocks: ten waves on one thread, five on two.
+    CompressedRows one, two;
+    NeighbourScratch scratch_one, scratch_two;
+    std::vector<std::size_t> seen;  // what the memory check is shown, wave after wave
+    scratch_one.check_entries = [&](std::size_t entries) { seen.push_back(entries); };
+    search_on(1, 1.2, one, scratch_one);
+    search_on(2, 1.2, two, scratch_two);
+    EXPECT_EQ(one, two);  // identical lists, identical order
+    EXPECT_GT(one.entries(), 10 * n.size());
+    ASSERT_EQ(seen.size(), 10u);
+    EXPECT_TRUE(std::is_sorted(seen.begin(), seen.end()));
+    EXPECT_EQ(seen.back(), one.entries());
+    // Lists made before by a smaller search, in the same arrays: the later waves outgrow them.
+    CompressedRows grown;
+    NeighbourScratch scratch;
+    search_on(2, 0.8, grown, scratch);
+    const std::size_t before = grown.indices.capacity();
+    search_on(2, 1.2, grown, scratch);
+    EXPECT_LT(before, grown.entries());
+    EXPECT_EQ(grown, two);
+    // Against all pairs on a cloud of six blocks, in two waves on one thread.
+    auto small = random_cloud(GeometryKind::ThreeD, 6000, 12);
+    for (auto& d : small.diameter) d *= 0.8;
+    CompressedRows waves;
+    NeighbourScratch small_scratch;
+    tbb::task_arena arena(1);
+    arena.execute([&] { find_neighbours(small, 1.2, small.size(), waves, small_scratch); });
+    expect_same_sets(waves, find_neighbours_brute_force(small, 1.2, small.size()));
 }
 
 TEST(Reorder, LocalityOrderIsAPermutationThatKeepsListsConsistent) {

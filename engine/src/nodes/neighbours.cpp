@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include "gpa/engine/errors.hpp"
 #include "gpa/engine/weights.hpp"
@@ -405,26 +406,61 @@ void find_neighbours(const NodeStore& nodes, InfluenceDistance influence, std::s
         scan(scratch.outsized_grid, cells_within(scratch.outsized_grid, outsized_distance), outsized_distance);
     };
 
-    // Two passes, count and fill, straight into the output: no per-block buffers, so the peak
-    // memory of a search is the lists themselves (the search runs once in many steps with a skin).
+    // One gather per row, in waves of blocks: the blocks of a wave (search_block centres each, in
+    // parallel) gather their rows into buffers of their own, then the wave's rows are copied after
+    // the last wave's. (Counting every row first and filling after, straight into the lists, walked
+    // every cell twice.) A wave is a thirty-second of the blocks, or four per thread if that is
+    // more, so that its buffers add little to the peak of a search: the lists themselves. Where a
+    // row lands depends on the rows before it alone, not on the waves or the threads.
     resize_discarding(out.offsets, rows + 1);
     out.offsets[0] = 0;
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rows, search_block), [&](const tbb::blocked_range<std::size_t>& r) {
-        for (std::size_t k = r.begin(); k != r.end(); ++k) {
-            std::size_t count = 0;
-            visit(centre_of(k), [&](NodeIndex) { ++count; });
-            out.offsets[k + 1] = count;
+    const std::size_t blocks = (rows + search_block - 1) / search_block;
+    const auto threads = static_cast<std::size_t>(std::max(1, tbb::this_task_arena::max_concurrency()));
+    const std::size_t wave = std::max((blocks + 31) / 32, 4 * threads);
+    std::vector<std::vector<NodeIndex>>& buffers = scratch.block_entries;
+    buffers.resize(std::min(blocks, wave));
+    const std::size_t previous = out.indices.size();  // the last search's entries, a guess at this one's
+    for (std::size_t first_block = 0; first_block < blocks; first_block += wave) {
+        const std::size_t last_block = std::min(blocks, first_block + wave);
+        const std::size_t first_row = first_block * search_block, last_row = std::min(rows, last_block * search_block);
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(first_block, last_block, 1), [&](const tbb::blocked_range<std::size_t>& r) {
+            for (std::size_t b = r.begin(); b != r.end(); ++b) {
+                std::vector<NodeIndex>& entries = buffers[b - first_block];
+                entries.clear();
+                const std::size_t end = std::min(rows, (b + 1) * search_block);
+                for (std::size_t k = b * search_block; k != end; ++k) {
+                    const std::size_t before = entries.size();
+                    visit(centre_of(k), [&](NodeIndex j) { entries.push_back(j); });
+                    out.offsets[k + 1] = entries.size() - before;
+                }
+            }
+        });
+        for (std::size_t k = first_row; k < last_row; ++k) out.offsets[k + 1] += out.offsets[k];
+        const std::size_t entries = out.offsets[last_row];
+        // The memory limit (Simulation) sees the entries made so far, before they are placed.
+        if (scratch.check_entries && only.empty()) scratch.check_entries(entries);
+        // Room for all rows at the rate of those made so far (and for as many entries as the last
+        // search made): taken before the first wave lands, when nothing is kept and nothing is
+        // copied, if that rate asks for more than the lists hold; after it, only when they are full.
+        const auto rate = static_cast<double>(entries) / static_cast<double>(last_row);
+        const std::size_t guess = std::max({entries, static_cast<std::size_t>(rate * static_cast<double>(rows)), previous});
+        if (first_block == 0 && guess > out.indices.capacity()) {
+            resize_discarding(out.indices, guess, per_entry_slack);
+        } else if (entries > out.indices.capacity()) {
+            out.indices.reserve(guess + guess / per_entry_slack);
         }
-    });
-    for (std::size_t k = 0; k < rows; ++k) out.offsets[k + 1] += out.offsets[k];
-    if (scratch.check_entries && only.empty()) scratch.check_entries(out.offsets[rows]);
-    resize_discarding(out.indices, out.offsets[rows], per_entry_slack);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rows, search_block), [&](const tbb::blocked_range<std::size_t>& r) {
-        for (std::size_t k = r.begin(); k != r.end(); ++k) {
-            std::size_t next = out.offsets[k];
-            visit(centre_of(k), [&](NodeIndex j) { out.indices[next++] = j; });
-        }
-    });
+        out.indices.resize(entries);
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(first_block, last_block, 1), [&](const tbb::blocked_range<std::size_t>& r) {
+            for (std::size_t b = r.begin(); b != r.end(); ++b) {
+                const std::vector<NodeIndex>& made = buffers[b - first_block];
+                std::copy(made.begin(), made.end(), out.indices.begin() + static_cast<std::ptrdiff_t>(out.offsets[b * search_block]));
+            }
+        });
+    }
+    if (blocks == 0) {
+        out.indices.clear();
+        if (scratch.check_entries && only.empty()) scratch.check_entries(0);
+    }
 }
 
 CompressedRows find_neighbours(const NodeStore& nodes, double a, std::size_t centres) {

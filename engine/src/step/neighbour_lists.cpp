@@ -547,6 +547,9 @@ void NeighbourLists::memory_use(MemoryUse& out) const {
     add_memory(out, "neighbour lists: scatter plan",
                allocated_bytes(plan_.centres) + allocated_bytes(plan_.group_offsets) + allocated_bytes(plan_.colour_offsets));
     add_memory(out, "neighbour lists: cell grid", allocated_bytes(scratch_.grid.nodes) + allocated_bytes(scratch_.grid.cell_start));
+    std::size_t wave = 0;
+    for (const auto& b : scratch_.block_entries) wave += allocated_bytes(b);
+    add_memory(out, "neighbour lists: a search's wave of rows", wave);
 }
 
 }  // namespace gpa

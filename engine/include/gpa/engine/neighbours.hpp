@@ -59,9 +59,12 @@ struct NeighbourScratch {
     // searches again then). Without fixed_may_switch a quiet centre's scan would find no pair,
     // and is skipped too (the lists are the same).
     std::vector<std::uint8_t> quiet;
-    // Called with the number of entries the lists will hold, after they are counted and before
-    // they are allocated; may throw (a memory limit, Simulation). Empty: no check.
+    // Called with the number of entries the lists hold so far, after each wave of rows is made
+    // and before it is placed, the last time with them all; may throw (a memory limit,
+    // Simulation). Empty: no check.
     std::function<void(std::size_t entries)> check_entries;
+    // The rows a block of a search's wave makes, one buffer per block of a wave (find_neighbours).
+    std::vector<std::vector<NodeIndex>> block_entries;
 };
 
 // The neighbour lists of centres [0, centres), drawn from all nodes [0, nodes.size()):
