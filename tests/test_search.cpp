@@ -304,30 +304,35 @@ TEST(Search, RowsMadeInWavesAreOneSearchWhateverTheThreadsAndTheListsBefore) {
     // lists grow in the later waves: about 3 to 80 neighbours per node at a = 1.2.
     auto n = random_cloud(GeometryKind::PlaneStrain, 40000, 11);
     for (std::size_t i = 0; i < n.size(); ++i) n.diameter[i] *= 0.05 + 0.2 * static_cast<double>(i) / static_cast<double>(n.size());
-    const auto search_on = [&](int threads, double a, CompressedRows& out, NeighbourScratch& scratch) {
+    const auto search_on = [](const NodeStore& nodes, int threads, double a, CompressedRows& out, NeighbourScratch& scratch) {
         tbb::task_arena arena(threads);
-        arena.execute([&] { find_neighbours(n, a, n.size(), out, scratch); });
+        arena.execute([&] { find_neighbours(nodes, a, nodes.size(), out, scratch); });
     };
     // 40 blocks: ten waves on one thread, five on two.
     CompressedRows one, two;
     NeighbourScratch scratch_one, scratch_two;
     std::vector<std::size_t> seen;  // what the memory check is shown, wave after wave
     scratch_one.check_entries = [&](std::size_t entries) { seen.push_back(entries); };
-    search_on(1, 1.2, one, scratch_one);
-    search_on(2, 1.2, two, scratch_two);
+    search_on(n, 1, 1.2, one, scratch_one);
+    search_on(n, 2, 1.2, two, scratch_two);
     EXPECT_EQ(one, two);  // identical lists, identical order
     EXPECT_GT(one.entries(), 10 * n.size());
     ASSERT_EQ(seen.size(), 10u);
     EXPECT_TRUE(std::is_sorted(seen.begin(), seen.end()));
     EXPECT_EQ(seen.back(), one.entries());
-    // Lists made before by a smaller search, in the same arrays: the later waves outgrow them.
-    CompressedRows grown;
-    NeighbourScratch scratch;
-    search_on(2, 0.8, grown, scratch);
+    // The lists' room is guessed from every 32nd row; with those rows' nodes made small, the guess
+    // falls short and the lists outgrow their room in a later wave, as they do after a smaller
+    // search in the same arrays.
+    auto m = n;
+    for (std::size_t i = 0; i < m.size(); i += 32) m.diameter[i] *= 0.01;
+    CompressedRows fresh, grown;
+    NeighbourScratch fresh_scratch, scratch;
+    search_on(m, 2, 1.2, fresh, fresh_scratch);
+    search_on(m, 2, 0.8, grown, scratch);
     const std::size_t before = grown.indices.capacity();
-    search_on(2, 1.2, grown, scratch);
+    search_on(m, 2, 1.2, grown, scratch);
     EXPECT_LT(before, grown.entries());
-    EXPECT_EQ(grown, two);
+    EXPECT_EQ(grown, fresh);
     // Against all pairs on a cloud of six blocks, in two waves on one thread.
     auto small = random_cloud(GeometryKind::ThreeD, 6000, 12);
     for (auto& d : small.diameter) d *= 0.8;

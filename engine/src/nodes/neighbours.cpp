@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
 #include <tbb/task_arena.h>
 
 #include "gpa/engine/errors.hpp"
@@ -419,7 +420,24 @@ void find_neighbours(const NodeStore& nodes, InfluenceDistance influence, std::s
     const std::size_t wave = std::max((blocks + 31) / 32, 4 * threads);
     std::vector<std::vector<NodeIndex>>& buffers = scratch.block_entries;
     buffers.resize(std::min(blocks, wave));
-    const std::size_t previous = out.indices.size();  // the last search's entries, a guess at this one's
+    // The lists' size, guessed before the first wave from every 32nd row (counted, a thirtieth of a
+    // scan more): room made then costs no copy, while lists that outgrow their room in a later wave
+    // are copied, the old array beside the new one (the first waves' rows, in locality order, may be
+    // a face's, with half the neighbours of the bulk).
+    constexpr std::size_t sample_stride = 32;
+    const std::size_t sampled = (rows + sample_stride - 1) / sample_stride;
+    const std::size_t sample_entries = tbb::parallel_reduce(
+        tbb::blocked_range<std::size_t>(0, sampled, 64), std::size_t{0},
+        [&](const tbb::blocked_range<std::size_t>& r, std::size_t sum) {
+            for (std::size_t s = r.begin(); s != r.end(); ++s) visit(centre_of(s * sample_stride), [&](NodeIndex) { ++sum; });
+            return sum;
+        },
+        std::plus<>());
+    const std::size_t estimate = sampled > 0 ? sample_entries * rows / sampled : 0;
+    if (estimate > out.indices.capacity()) {
+        std::vector<NodeIndex>().swap(out.indices);  // the old lists go before the new ones are made
+        out.indices.reserve(estimate + estimate / per_entry_slack);
+    }
     for (std::size_t first_block = 0; first_block < blocks; first_block += wave) {
         const std::size_t last_block = std::min(blocks, first_block + wave);
         const std::size_t first_row = first_block * search_block, last_row = std::min(rows, last_block * search_block);
@@ -439,14 +457,10 @@ void find_neighbours(const NodeStore& nodes, InfluenceDistance influence, std::s
         const std::size_t entries = out.offsets[last_row];
         // The memory limit (Simulation) sees the entries made so far, before they are placed.
         if (scratch.check_entries && only.empty()) scratch.check_entries(entries);
-        // Room for all rows at the rate of those made so far (and for as many entries as the last
-        // search made): taken before the first wave lands, when nothing is kept and nothing is
-        // copied, if that rate asks for more than the lists hold; after it, only when they are full.
-        const auto rate = static_cast<double>(entries) / static_cast<double>(last_row);
-        const std::size_t guess = std::max({entries, static_cast<std::size_t>(rate * static_cast<double>(rows)), previous});
-        if (first_block == 0 && guess > out.indices.capacity()) {
-            resize_discarding(out.indices, guess, per_entry_slack);
-        } else if (entries > out.indices.capacity()) {
+        if (entries > out.indices.capacity()) {
+            // Room for all rows at the rate of those made so far.
+            const auto rate = static_cast<double>(entries) / static_cast<double>(last_row);
+            const std::size_t guess = std::max(entries, static_cast<std::size_t>(rate * static_cast<double>(rows)));
             out.indices.reserve(guess + guess / per_entry_slack);
         }
         out.indices.resize(entries);
