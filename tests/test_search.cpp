@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 #include <tbb/task_arena.h>
 
+#include "gpa/engine/errors.hpp"
 #include "gpa/engine/ghosts.hpp"
 #include "gpa/engine/memory_use.hpp"
 #include "gpa/engine/neighbours.hpp"
@@ -317,8 +318,12 @@ TEST(Search, RowsMadeInWavesAreOneSearchWhateverTheThreadsAndTheListsBefore) {
     search_on(n, 2, 1.2, two, scratch_two);
     EXPECT_EQ(one, two);  // identical lists, identical order
     EXPECT_GT(one.entries(), 10 * n.size());
-    ASSERT_EQ(seen.size(), 10u);
-    EXPECT_TRUE(std::is_sorted(seen.begin(), seen.end()));
+    // First the guess from every 32nd row, then the entries made so far after each of the ten
+    // waves. The guess: a sample of 1250 rows whose sizes change smoothly with the index, so within
+    // a tenth of the lists.
+    ASSERT_EQ(seen.size(), 11u);
+    EXPECT_NEAR(static_cast<double>(seen.front()) / static_cast<double>(one.entries()), 1.0, 0.1);
+    EXPECT_TRUE(std::is_sorted(seen.begin() + 1, seen.end()));
     EXPECT_EQ(seen.back(), one.entries());
     // The lists' room is guessed from every 32nd row; with those rows' nodes made small, the guess
     // falls short and the lists outgrow their room in a later wave, as they do after a smaller
@@ -333,6 +338,24 @@ TEST(Search, RowsMadeInWavesAreOneSearchWhateverTheThreadsAndTheListsBefore) {
     search_on(m, 2, 1.2, grown, scratch);
     EXPECT_LT(before, grown.entries());
     EXPECT_EQ(grown, fresh);
+    // A guess beyond the memory limit refuses nothing: with every 32nd node three times as large,
+    // the guess is several times the lists, and a limit between the two lets the search end with
+    // the lists of a search without a limit.
+    auto big = n;
+    for (std::size_t i = 0; i < big.size(); i += 32) big.diameter[i] *= 3.0;
+    CompressedRows unlimited, limited;
+    NeighbourScratch unlimited_scratch, limited_scratch;
+    std::vector<std::size_t> guesses;
+    unlimited_scratch.check_entries = [&](std::size_t entries) { guesses.push_back(entries); };
+    search_on(big, 2, 1.2, unlimited, unlimited_scratch);
+    ASSERT_GT(guesses.front(), 2 * unlimited.entries());
+    const std::size_t limit = unlimited.entries() + unlimited.entries() / 2;
+    limited_scratch.check_entries = [&](std::size_t entries) {
+        if (entries > limit) throw LimitError("a test limit");
+    };
+    search_on(big, 2, 1.2, limited, limited_scratch);
+    EXPECT_EQ(limited, unlimited);
+    EXPECT_LT(limited.indices.capacity(), guesses.front());  // no room made for the guess
     // Against all pairs on a cloud of six blocks, in two waves on one thread.
     auto small = random_cloud(GeometryKind::ThreeD, 6000, 12);
     for (auto& d : small.diameter) d *= 0.8;

@@ -420,10 +420,12 @@ void find_neighbours(const NodeStore& nodes, InfluenceDistance influence, std::s
     const std::size_t wave = std::max((blocks + 31) / 32, 4 * threads);
     std::vector<std::vector<NodeIndex>>& buffers = scratch.block_entries;
     buffers.resize(std::min(blocks, wave));
-    // The lists' size, guessed before the first wave from every 32nd row (counted, a thirtieth of a
-    // scan more): room made then costs no copy, while lists that outgrow their room in a later wave
-    // are copied, the old array beside the new one (the first waves' rows, in locality order, may be
-    // a face's, with half the neighbours of the bulk).
+    // The lists' size, guessed before the first wave from every 32nd row (counted, a thirty-second
+    // of a scan more): room made then costs no copy, while lists that outgrow their room in a later
+    // wave are copied, the old array beside the new one (the first waves' rows, in locality order,
+    // may be a face's, with half the neighbours of the bulk). No room is made for a guess beyond
+    // the memory limit: the waves' own checks then stop the search with the limit's error, at the
+    // entries actually made, instead of an allocation failing or a guess refusing lists that fit.
     constexpr std::size_t sample_stride = 32;
     const std::size_t sampled = (rows + sample_stride - 1) / sample_stride;
     const std::size_t sample_entries = tbb::parallel_reduce(
@@ -434,7 +436,15 @@ void find_neighbours(const NodeStore& nodes, InfluenceDistance influence, std::s
         },
         std::plus<>());
     const std::size_t estimate = sampled > 0 ? sample_entries * rows / sampled : 0;
-    if (estimate > out.indices.capacity()) {
+    bool estimate_fits = true;
+    if (scratch.check_entries && only.empty()) {
+        try {
+            scratch.check_entries(estimate);
+        } catch (const LimitError&) {
+            estimate_fits = false;
+        }
+    }
+    if (estimate_fits && estimate > out.indices.capacity()) {
         std::vector<NodeIndex>().swap(out.indices);  // the old lists go before the new ones are made
         out.indices.reserve(estimate + estimate / per_entry_slack);
     }
