@@ -61,7 +61,8 @@ struct NeighbourScratch {
     std::vector<std::uint8_t> quiet;
     // Called with the number of entries the lists hold so far, after each wave of rows is made
     // and before it is placed, the last time with them all; may throw (a memory limit,
-    // Simulation). Empty: no check.
+    // Simulation). A full search calls it first with its guess of the entries (from every 32nd
+    // row): a LimitError there only withholds room for the guess. Empty: no check.
     std::function<void(std::size_t entries)> check_entries;
     // The rows a block of a search's wave makes, one buffer per block of a wave (find_neighbours).
     std::vector<std::vector<NodeIndex>> block_entries;
