@@ -68,6 +68,43 @@ TEST(MeasureBase, ABodyOffThePlaneIsMeasuredFromItsUnderside) {
     EXPECT_DOUBLE_EQ(el.footprint(), 6.0);
 }
 
+// A face that has lifted off springs back dished: its middle lowest, its nodes further out a little
+// higher, not level to round-off. From its underside an element node is on the face within half
+// a spacing, as a particle whose centre lies within half a cell of the lowest centre; on the plane
+// the tolerance stays at round-off (contact puts the nodes on it).
+TEST(MeasureBase, ADishedUndersideOfElementsCountsTheNodesWithinHalfASpacing) {
+    const double h = 1e-3;  // the body's mesh spacing
+    // Radii 0, 1, 2, 3, 4 mm along the underside, raised 0, 1e-9, 0.1 h, 0.49 h and 0.51 h above the
+    // lowest node, 5 mm above the plane; a top node 10 mm up.
+    const std::array<double, 5> rise{0.0, 1e-9, 0.1 * h, 0.49 * h, 0.51 * h};
+    const auto pass = [&](double b) {
+        measure::Extent x;
+        for (int k = 0; k < 5; ++k) {
+            measure::add_element_node(x, 5e-3 + rise[static_cast<std::size_t>(k)] - b, k * 1e-3, measure::element_face_tolerance(h, b), true);
+        }
+        measure::add_element_node(x, 15e-3 - b, 0.0, measure::element_face_tolerance(h, b), true);
+        return x;
+    };
+    double base = 0.0;
+    const measure::Extent e = measure::measure_extent(pass, &base);
+    EXPECT_DOUBLE_EQ(base, 5e-3);
+    EXPECT_DOUBLE_EQ(e.length(), 10e-3);
+    EXPECT_DOUBLE_EQ(e.footprint(), 6e-3);  // radii up to 3 mm; the node 0.51 h up is not on the face
+    // The same underside standing on the plane: only the nodes on it to round-off (within 1e-6 h)
+    // are on the face.
+    double on_plane = -1.0;
+    const auto standing = [&](double b) {
+        measure::Extent x;
+        for (int k = 0; k < 5; ++k) {
+            measure::add_element_node(x, rise[static_cast<std::size_t>(k)] - b, k * 1e-3, measure::element_face_tolerance(h, b), true);
+        }
+        return x;
+    };
+    const measure::Extent s = measure::measure_extent(standing, &on_plane);
+    EXPECT_EQ(on_plane, 0.0);
+    EXPECT_DOUBLE_EQ(s.footprint(), 2e-3);  // radii 0 and 1 mm (the second 1e-9 above the plane)
+}
+
 TEST(MeasureBase, AnElasticBarThatBouncedOffKeepsItsLengthAndFootprint) {
     Scene s = io::load_scene(std::string(GPA_SOURCE_DIR) + "/scenes/elastic-bar.toml");
     s.bodies[0].spacing = 0.25e-3;  // 4 across the 1 mm radius: enough for a length

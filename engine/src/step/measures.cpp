@@ -188,8 +188,8 @@ measure::Extent Measures::particle_extent(const NodeStore& nodes, std::size_t re
 }
 
 measure::Extent Measures::element_extent(const ElementMesh& m, const GhostPlane& plane, bool axisymmetric, double base) {
-    // The element rule of measure.hpp: nodes lie on the boundary (no d/2), "on the plane" within
-    // the face tolerance of the node's body.
+    // The element rule of measure.hpp: nodes lie on the boundary (no d/2), "on the face" within
+    // the face tolerance of the node's body from `base`.
     // Element scenes have aligned planes only (validate_scene).
     const int across = plane.axis == 0 ? 1 : 0;
     return tbb::parallel_reduce(
@@ -198,7 +198,7 @@ measure::Extent Measures::element_extent(const ElementMesh& m, const GhostPlane&
             for (std::size_t i = r.begin(); i != r.end(); ++i) {
                 const double spacing = m.body_spacing[static_cast<std::size_t>(m.nodes.body[i])];
                 measure::add_element_node(acc, plane.distance(m.nodes.position[plane.axis][i]) - base, m.nodes.position[across][i],
-                                          measure::element_face_tolerance(spacing), axisymmetric && across == 0);
+                                          measure::element_face_tolerance(spacing, base), axisymmetric && across == 0);
             }
             return acc;
         },
@@ -340,7 +340,8 @@ void Measures::local_fields(const Scene& scene, const NodeStore& nodes, std::siz
                 heat.push_back(m.points.temperature[t]);
                 if (plane) {
                     // A triangle whose outer edge lies on the base.
-                    const double tol = measure::element_face_tolerance(m.body_spacing[static_cast<std::size_t>(m.quads.body[q])]);
+                    const double tol =
+                        measure::element_face_tolerance(m.body_spacing[static_cast<std::size_t>(m.quads.body[q])], base_height);
                     const double hb = plane->distance(m.nodes.position[plane->axis][b]) - base_height;
                     const double hc = plane->distance(m.nodes.position[plane->axis][c]) - base_height;
                     if (hb <= tol && hc <= tol) {

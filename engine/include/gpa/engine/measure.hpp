@@ -16,7 +16,8 @@
 //   elements:  nodes lie on the body's boundary, so the body ends at them:
 //     top       = height
 //     lowest    = height
-//     on face   = height - base <= face tolerance (nodes in contact lie on the plane to round-off)
+//     on face   = height - base <= face tolerance (nodes in contact lie on the plane to round-off;
+//                 half a spacing from the underside of a body off the plane: element_face_tolerance)
 //     span      = [across, across]
 //
 // The base is the plane while the body stands on it (some point meets the face rule with base 0),
@@ -192,10 +193,14 @@ Extent measure_extent(Pass&& pass, double* base = nullptr) {
     return e;
 }
 
-// The tolerance of "on the plane" for element nodes of a body meshed at spacing h: contact puts
-// nodes on the plane to round-off (~1e-16 h); a node leaving it moves dt |v|, some 1e-4 h or more
-// per step at the speeds where lift-off matters.
-inline double element_face_tolerance(double spacing) { return 1e-6 * spacing; }
+// The tolerance of "on the face" for element nodes of a body meshed at spacing h, with heights
+// measured from `base` (measure_extent). From the plane (base 0): contact puts nodes on it to
+// round-off (~1e-16 h), and a node leaving it moves dt |v|, some 1e-4 h or more per step at the
+// speeds where lift-off matters, so 1e-6 h. From the underside of a body off the plane (base not
+// 0): an underside is not flat to round-off (a face that has lifted off springs back dished, its
+// middle lowest), so half a spacing, the reach of the particle rule (a node is on the face when
+// its centre lies within half a cell of the lowest centre). docs/measurement.md has the figures.
+inline double element_face_tolerance(double spacing, double base = 0.0) { return base == 0.0 ? 1e-6 * spacing : 0.5 * spacing; }
 
 // The outer radius a particle of diameter d at `across` contributes to a profile, and an element
 // node's: the same offsets as the spans above.
