@@ -280,6 +280,55 @@ TEST(NeighbourSkin, CutCandidatesEqualAFullSearchEveryStep) {
     }
 }
 
+// Where no body is automatic, a fixed centre's row of lattice entries alone is kept whole by the cut
+// without a look at its entries (filter_candidates, LatticeRowsKept); with automatic bodies only the
+// quiet rows are, whose lattice neighbours a switch within reach sends to a new search first. The
+// lists must be those of a full search every step (check_neighbour_lists throws otherwise), with the
+// anvil's mirrored lattice rows in 2D and the symmetry planes' and the anvil's in a 3D quarter, and
+// the same on 1 and 2 threads.
+TEST(NeighbourSkin, LatticeRowsKeptWholeAreThoseOfAFullSearchEveryStep) {
+    struct Case {
+        const char* name;
+        Scene scene;
+        int steps;
+    };
+    std::vector<Case> cases;
+    {
+        auto scene = testing::armco_cylinder(6, 40e-6);
+        scene.solver.connectivity = ConnectivityMode::Fixed;
+        cases.push_back({"axisymmetric Taylor bar, fixed", scene, 200});  // its lattice cells collapse at step 222
+    }
+    {
+        auto scene = three_d_cylinder(4);
+        scene.solver.connectivity = ConnectivityMode::Fixed;
+        cases.push_back({"3D quarter bar, fixed", scene, 120});
+    }
+    {
+        auto scene = three_d_cylinder(4);
+        scene.solver.connectivity = ConnectivityMode::Automatic;
+        scene.solver.switch_plastic_strain = 0.02;  // nodes next to quiet centres switch early
+        cases.push_back({"3D quarter bar, automatic switching", scene, 120});
+    }
+    for (auto& c : cases) {
+        SCOPED_TRACE(c.name);
+        c.scene.solver.check_neighbour_lists = true;
+        Simulation one(c.scene, 1), two(c.scene, 2);
+        for (int k = 0; k < c.steps && !one.finished(); ++k) {
+            ASSERT_NO_THROW(one.step()) << "step " << k;
+            ASSERT_NO_THROW(two.step()) << "step " << k;
+        }
+        const Totals& t = one.totals();
+        std::printf("[ measured ] %s: %zu steps, %zu full searches, %zu variable nodes of %zu\n", c.name, one.steps(),
+                    t.neighbour_searches, t.variable_nodes, t.real_nodes);
+        EXPECT_EQ(one.steps(), static_cast<std::size_t>(c.steps)) << "the run must take every step";
+        EXPECT_TRUE(testing::node_bytes(one) == testing::node_bytes(two));
+        if (c.scene.solver.connectivity == ConnectivityMode::Automatic) {
+            EXPECT_GT(t.variable_nodes, 0u) << "nodes must switch";
+            EXPECT_LT(t.variable_nodes, t.real_nodes) << "and some stay fixed";
+        }
+    }
+}
+
 // A small fast body striking a resting one: only the nodes that move (the projectile and the
 // face it strikes) use up the skin, and the rows of those nodes alone are searched again
 // (NeighbourLists::search_rows), each pair found put into both rows. Every step's lists must

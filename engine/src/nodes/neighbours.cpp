@@ -506,7 +506,8 @@ std::size_t first_keep_word(std::size_t row, std::size_t first_entry) { return r
 
 template <int D>
 void filter_rows(const NodeStore& nodes, double a, const CompressedRows& candidates,
-                 const std::vector<std::uint32_t>& lattice_entries, CompressedRows& out, std::vector<std::uint64_t>& keep) {
+                 const std::vector<std::uint32_t>& lattice_entries, const LatticeRowsKept& kept_rows, CompressedRows& out,
+                 std::vector<std::uint64_t>& keep) {
     const std::size_t rows = candidates.rows();
     std::array<const double*, D> x{};
     for (int c = 0; c < D; ++c) x[c] = nodes.position[c].data();
@@ -522,6 +523,15 @@ void filter_rows(const NodeStore& nodes, double a, const CompressedRows& candida
     const std::uint32_t* lattice_counts = lattice_entries.empty() ? nullptr : lattice_entries.data();  // none: 0 per row
     std::size_t* counts = out.offsets.data();
     std::uint64_t* keep_out = keep.data();
+    // A fixed centre's row of lattice entries alone is kept whole where no lattice pair can have
+    // lost a node to switching (LatticeRowsKept): its count is its length, its entries are
+    // copied in pass 2, and neither pass reads them one by one.
+    const bool no_switching = !kept_rows.switching;
+    const std::uint8_t* const quiet = kept_rows.quiet;
+    const auto whole = [mode, lattice_counts, quiet, no_switching](std::size_t i, std::size_t first, std::size_t last) {
+        return lattice_counts && mode[i] == Connectivity::Fixed && first + lattice_counts[i] >= last &&
+               (no_switching || (quiet && quiet[i]));
+    };
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rows, filter_block), [&](const tbb::blocked_range<std::size_t>& r) {
         // The pointers and a as locals of the task, so that the loop need not load them again
         // after each store through a pointer that might alias its captures.
@@ -533,6 +543,10 @@ void filter_rows(const NodeStore& nodes, double a, const CompressedRows& candida
         const double influence = a;
         for (std::size_t i = r.begin(); i != r.end(); ++i) {
             const std::size_t first = candidate_offsets[i], last = candidate_offsets[i + 1];
+            if (whole(i, first, last)) {
+                counts[i + 1] = last - first;
+                continue;
+            }
             const std::size_t lattice_end = lattice_counts ? std::min(last, first + lattice_counts[i]) : first;
             const bool fixed_centre = modes[i] == Connectivity::Fixed;
             std::array<double, D> xi;
@@ -580,6 +594,10 @@ void filter_rows(const NodeStore& nodes, double a, const CompressedRows& candida
         for (std::size_t i = r.begin(); i != r.end(); ++i) {
             NodeIndex* o = kept_index + out.offsets[i];
             const std::size_t first = candidates.offsets[i], last = candidates.offsets[i + 1];
+            if (whole(i, first, last)) {
+                std::copy(index + first, index + last, o);
+                continue;
+            }
             const std::uint64_t* word = kept + first_keep_word(i, first);
             for (std::size_t base = first; base < last; base += 64, ++word) {
                 for (std::uint64_t bits = *word; bits != 0; bits &= bits - 1) *o++ = index[base + static_cast<std::size_t>(std::countr_zero(bits))];
@@ -592,18 +610,21 @@ void filter_rows(const NodeStore& nodes, double a, const CompressedRows& candida
 
 void filter_candidates(const NodeStore& nodes, double a, const CompressedRows& candidates,
                        const std::vector<std::uint32_t>& lattice_entries, CompressedRows& out,
-                       std::vector<std::uint64_t>& keep) {
+                       std::vector<std::uint64_t>& keep, const LatticeRowsKept& kept_rows) {
     const std::size_t rows = candidates.rows();
     if (!lattice_entries.empty() && lattice_entries.size() < rows) {
         throw InputError(fmt::format("filter_candidates: {} lattice counts for {} rows", lattice_entries.size(), rows));
+    }
+    if (kept_rows.quiet && kept_rows.quiet_rows < rows) {
+        throw InputError(fmt::format("filter_candidates: {} quiet flags for {} rows", kept_rows.quiet_rows, rows));
     }
     resize_discarding(keep, rows + candidates.entries() / 64 + 1, per_entry_slack);  // first_keep_word's words
     resize_discarding(out.offsets, rows + 1);
     out.offsets[0] = 0;
     if (nodes.dim() == 2) {
-        filter_rows<2>(nodes, a, candidates, lattice_entries, out, keep);
+        filter_rows<2>(nodes, a, candidates, lattice_entries, kept_rows, out, keep);
     } else {
-        filter_rows<3>(nodes, a, candidates, lattice_entries, out, keep);
+        filter_rows<3>(nodes, a, candidates, lattice_entries, kept_rows, out, keep);
     }
 }
 

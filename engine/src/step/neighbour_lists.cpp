@@ -457,7 +457,13 @@ void NeighbourLists::update(NodeStore& nodes, std::size_t real, GhostSet& ghosts
         } else if (!rows_due_.empty()) {
             search_rows(nodes, real, ghosts, influence_distance, any_automatic);
         }
-        filter_candidates(nodes, influence_distance.value(), candidates_, lattice_entries_, lists_, keep_scratch_);
+        // The quiet rows' lattice pairs are whole until a node near one of them switches, which
+        // place_ghosts turns into a search before this cut (switched_near_quiet_rows).
+        LatticeRowsKept kept_rows;
+        kept_rows.switching = any_automatic;
+        kept_rows.quiet = quiet_.data();
+        kept_rows.quiet_rows = quiet_.size();
+        filter_candidates(nodes, influence_distance.value(), candidates_, lattice_entries_, lists_, keep_scratch_, kept_rows);
         if (!ghosts.empty()) ghosts.remove_pairs_without_contact(lists_, nodes, real);
         if (solver_->check_neighbour_lists) check_against_search(nodes, real, ghosts, influence_distance, step);
         contact.separate(lists_, nodes, real, influence_distance.value());

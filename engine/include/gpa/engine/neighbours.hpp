@@ -98,9 +98,22 @@ CompressedRows find_neighbours(const NodeStore& nodes, double influence_distance
 // mode; lattice_entries empty: no row has any) while both nodes are fixed, and every j with
 // r_ij < 2 h_ij that is not a pair of two fixed nodes of one body (spec section 2). Nodes may switch between the search and the cut.
 // Deterministic and independent of the thread count.
+//
+// What the caller knows of the lattice pairs, so that a fixed centre's row of lattice entries alone
+// (no other entry after them) is kept whole without a look at its entries: without `switching` (no
+// automatic body) every lattice pair links two fixed nodes for good, so every such row is kept
+// whole; with it, only the rows whose `quiet` flag is set (NeighbourScratch::quiet, one per row, of
+// the search that made the candidates), which the caller searches again before a cut whenever a
+// node within reach of a quiet centre has switched (NeighbourLists). The lists are the same either
+// way; the default takes nothing for granted.
+struct LatticeRowsKept {
+    bool switching = true;
+    const std::uint8_t* quiet = nullptr;
+    std::size_t quiet_rows = 0;
+};
 void filter_candidates(const NodeStore& nodes, double influence_distance, const CompressedRows& candidates,
                        const std::vector<std::uint32_t>& lattice_entries, CompressedRows& out,
-                       std::vector<std::uint64_t>& keep);
+                       std::vector<std::uint64_t>& keep, const LatticeRowsKept& kept_rows = {});
 
 // The same lists from an all-pairs loop: the check for find_neighbours. O(n^2).
 CompressedRows find_neighbours_brute_force(const NodeStore& nodes, double influence_distance,
