@@ -1,6 +1,7 @@
 #include "gpa/engine/ghosts.hpp"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <bit>
 #include <cmath>
@@ -477,9 +478,7 @@ void GhostSet::append_ghost_rows(CompressedRows& lists, std::size_t real_count) 
     }
     constexpr std::size_t grain = 256;  // sources per task
     const tbb::blocked_range<std::size_t> all_sources(0, sources_sorted_.size(), grain);
-    // count[t + 1] for ghost t, then `spare` slots that the entries which count nothing add 0 to.
-    constexpr std::size_t spare = 8;
-    std::vector<std::size_t> count(ghosts + 1 + spare, 0);
+    std::vector<std::size_t> count(ghosts + 1, 0);  // count[t + 1] for ghost t
     std::atomic<std::size_t> first_missing{std::numeric_limits<std::size_t>::max()};  // the smallest source at fault
     tbb::parallel_for(all_sources, [&](const tbb::blocked_range<std::size_t>& r) {
         // The arrays' addresses and each row's end as locals: a store to count[] or next[] may
@@ -487,23 +486,28 @@ void GhostSet::append_ghost_rows(CompressedRows& lists, std::size_t real_count) 
         const NodeIndex* const indices = lists.indices.data();
         const std::uint8_t* const slot_of = slot_.data();
         std::size_t* const counts = count.data();
+        // Slots of this task's own that the entries which count nothing add 0 to, the next of them
+        // for each entry (below).
+        constexpr std::size_t spare = 8;
+        std::array<std::size_t, spare> nothing{};
         for (std::size_t q = r.begin(); q != r.end(); ++q) {
             const NodeIndex s = sources_sorted_[q];
             const std::int32_t* const ghost_of = ghost_table_.data() + q * slots;
             const std::size_t last = lists.offsets[s + 1];
             bool missing = false;
             // Without a branch on whether an entry is a ghost, which no predictor guesses (about a
-            // quarter of a source's entries are): an entry that counts nothing adds 0 to one of the
-            // spare slots, the next of them for each entry. (With one slot for them all, each entry's
-            // addition waited for the last one's to be stored: 60 % of this loop's time in the
-            // README main job.)
+            // quarter of a source's entries are): an entry that counts nothing adds 0 to one of
+            // the task's spare slots. One slot for them all made each addition wait for the last
+            // one's store (60 % of this loop's time in the README main job); spare slots in the
+            // shared count bounced their cache line between the threads (the main job's neighbours
+            // phase 1.4 times longer on 2 threads).
             for (std::size_t e = lists.offsets[s]; e < last; ++e) {
                 const NodeIndex j = indices[e];
                 const bool ghost = j >= real_count;
                 const std::int32_t t = ghost_of[slot_of[ghost ? j - real_count : 0]];
                 const bool counted = ghost && t >= 0;
                 missing |= ghost && t < 0;
-                counts[counted ? static_cast<std::size_t>(t) - real_count + 1 : ghosts + 1 + e % spare] += counted;
+                *(counted ? counts + (static_cast<std::size_t>(t) - real_count + 1) : nothing.data() + e % spare) += counted;
             }
             if (missing) {
                 std::size_t seen = first_missing.load();
