@@ -224,13 +224,15 @@ TEST(HourglassNodes, AllDampsEveryNodeWhateverTheSwitchingStrain) {
     EXPECT_LT(lattice.hourglass_work, all.hourglass_work);
 }
 
+// A scene of a test that checks its lists against a full search every step, for so many steps.
+struct ListsCase {
+    const char* name;
+    Scene scene;
+    int steps;
+};
+
 TEST(NeighbourSkin, CutCandidatesEqualAFullSearchEveryStep) {
-    struct Case {
-        const char* name;
-        Scene scene;
-        int steps;
-    };
-    std::vector<Case> cases;
+    std::vector<ListsCase> cases;
     cases.push_back({"axisymmetric Taylor bar, variable", testing::armco_cylinder(6, 40e-6), 300});
     {
         auto scene = testing::armco_cylinder(6, 40e-6);
@@ -287,12 +289,7 @@ TEST(NeighbourSkin, CutCandidatesEqualAFullSearchEveryStep) {
 // anvil's mirrored lattice rows in 2D and the symmetry planes' and the anvil's in a 3D quarter, and
 // the same on 1 and 2 threads.
 TEST(NeighbourSkin, LatticeRowsKeptWholeAreThoseOfAFullSearchEveryStep) {
-    struct Case {
-        const char* name;
-        Scene scene;
-        int steps;
-    };
-    std::vector<Case> cases;
+    std::vector<ListsCase> cases;
     {
         auto scene = testing::armco_cylinder(6, 40e-6);
         scene.solver.connectivity = ConnectivityMode::Fixed;

@@ -498,9 +498,8 @@ void GhostSet::append_ghost_rows(CompressedRows& lists, std::size_t real_count) 
             // Without a branch on whether an entry is a ghost, which no predictor guesses (about a
             // quarter of a source's entries are): an entry that counts nothing adds 0 to one of
             // the task's spare slots. One slot for them all made each addition wait for the last
-            // one's store (60 % of this loop's time in the README main job); spare slots in the
-            // shared count bounced their cache line between the threads (the main job's neighbours
-            // phase 1.4 times longer on 2 threads).
+            // one's store; spare slots in the shared count bounced their cache line between the
+            // threads (docs/performance.md section 5 has the figures).
             for (std::size_t e = lists.offsets[s]; e < last; ++e) {
                 const NodeIndex j = indices[e];
                 const bool ghost = j >= real_count;
