@@ -171,9 +171,15 @@ int check_scene(const fs::path& file, const MemoryLimit& memory) {
                        set.typical_diameter() * 1e3);
             continue;
         }
-        const auto block = body_lattice(scene, b);
         std::size_t count = 0;
         for (std::size_t i = 0; i < sim.real_count(); ++i) count += sim.nodes().body[i] == static_cast<int>(b);
+        if (const BodySpec& spec = scene.bodies[b];
+            spec.discretisation == Discretisation::Particles && dimension_of(scene.geometry) == 3 && cell_fill(spec, scene.geometry) == CellFill::Rings) {
+            fmt::print("  body \"{}\": {}, {} nodes in rings about its axis, spacing {:.4g} mm\n", spec.name, spec.material, count,
+                       spec.spacing * 1e3);
+            continue;
+        }
+        const auto block = body_lattice(scene, b);
         std::string elements;
         if (const ElementPart* e = sim.elements(); e && scene.bodies[b].discretisation == Discretisation::Elements) {
             count = static_cast<std::size_t>(std::count(e->mesh().nodes.body.begin(), e->mesh().nodes.body.end(), static_cast<int>(b)));

@@ -162,6 +162,17 @@ TEST(SymmetryCut, AQuarterOfAFixedTrimmedThreeDBarIsTheWholeBarsQuadrantToRoundO
     expect_same_run(a, b, 4, 100);
 }
 
+// A bar filled with rings (CellFill::Rings): the rings are their own mirror images across the
+// planes through the axis, so the quarter is the whole bar's quadrant as a lattice's is.
+TEST(SymmetryCut, AQuarterOfABarFilledWithRingsIsTheWholeBarsQuadrantToRoundOff) {
+    Scene whole = copper_bar(GeometryKind::ThreeD);
+    whole.solver.connectivity = ConnectivityMode::Variable;
+    whole.bodies[0].fill = CellFill::Rings;
+    const Scene quarter = cut(whole, {0, 1});
+    Simulation a(quarter, 2), b(whole, 2);
+    expect_same_run(a, b, 4, 150);
+}
+
 TEST(SymmetryCut, TheQuarterFillIsTheWholeFillsQuadrant) {
     const Scene whole = copper_bar(GeometryKind::ThreeD);
     const Scene quarter = cut(whole, {0, 1});

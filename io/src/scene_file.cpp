@@ -413,7 +413,7 @@ BodySpec read_body(const Reporter& reporter, const toml::table& table, std::size
     }
     b.connectivity = r.choice<ConnectivityMode>("connectivity", connectivity_words);
     if (const auto n = r.whole_number("lattice_neighbours", 0, 26)) b.lattice_neighbours = static_cast<int>(*n);
-    b.fill = r.choice<CellFill>("fill", {{"centres", CellFill::Centres}, {"trimmed", CellFill::Trimmed}});
+    b.fill = r.choice<CellFill>("fill", {{"centres", CellFill::Centres}, {"trimmed", CellFill::Trimmed}, {"rings", CellFill::Rings}});
     if (const auto rotation = read_rotation(r, geometry, "a body in an axisymmetric scene")) {
         if (b.discretisation == Discretisation::Elements) {
             r.fail_at("rotation", "applies to particle bodies only: an element body's mesh follows the scene's axes");

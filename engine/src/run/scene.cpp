@@ -520,6 +520,24 @@ void check_body(const Scene& scene, const BodySpec& b, std::size_t i) {
                             *b.connectivity == ConnectivityMode::Automatic)) {
         fail(fmt::format("{}.connectivity: unknown connectivity mode", label));
     }
+    if (b.fill == CellFill::Rings) {
+        // Rings of nodes about a cylinder's axis (bodies.hpp, ring_fill): no lattice, so no fixed lists.
+        if (dim != 3) {
+            fail(fmt::format("{}.fill = \"rings\" is for 3D bodies (an axisymmetric scene's nodes are rings already)", label));
+        }
+        if (b.shape != ShapeKind::Cylinder && b.shape != ShapeKind::Plate) {
+            fail(fmt::format("{}.fill = \"rings\" applies to cylinders and plates, not a {}", label, name_of(b.shape)));
+        }
+        const ConnectivityMode mode = b.connectivity.value_or(scene.solver.connectivity);
+        if (mode != ConnectivityMode::Variable) {
+            fail(fmt::format("{}.fill = \"rings\" has no lattice to keep fixed lists on: the body's connectivity must be "
+                             "\"variable\" (set [solver] connectivity or the body's own)",
+                             label));
+        }
+        if (b.lattice_neighbours != 0) {
+            fail(fmt::format("{}.lattice_neighbours: a body filled with rings has no lattice (its connectivity is variable)", label));
+        }
+    }
 }
 
 void check_plane(const Scene& scene, const PlaneSpec& p, std::size_t i) {
@@ -594,6 +612,21 @@ void check_plane(const Scene& scene, const PlaneSpec& p, std::size_t i) {
                                  "with a lattice (it keeps the cells on its side), but imported nodes must all lie on its "
                                  "side, a quarter of their median diameter or more from it",
                                  label, letter, p.position, body_label(b, k)));
+            }
+            if (b.shape != ShapeKind::Nodes && cell_fill(b, g) == CellFill::Rings) {
+                // Rings are mirror-symmetric about the planes through the axis along the body's own x
+                // and y (ring_fill), and about no other plane that cuts them.
+                const auto own = turn_back(b.rotation, n);
+                const double across = std::abs(own[0]) > std::abs(own[1]) ? std::abs(own[1]) : std::abs(own[0]);
+                double through = -p.position;
+                for (int c = 0; c < 3; ++c) through += n[c] * b.origin[c];
+                if (!(std::abs(own[2]) < 1e-12 && across < 1e-12 && std::abs(through) <= 1e-9 * b.spacing)) {
+                    fail(fmt::format("{} at {} = {} m cuts {}, which is filled with rings: a symmetry plane may cut such a body "
+                                     "only through its axis, along its own x or y axis (the rings are mirror images "
+                                     "across those two planes and no other)",
+                                     label, letter, p.position, body_label(b, k)));
+                }
+                continue;
             }
             // A half or quarter model: the body is filled on the plane's side (body_lattice), and the
             // plane's ghosts continue it across.

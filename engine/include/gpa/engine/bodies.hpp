@@ -2,6 +2,7 @@
 // From bodies to nodes (spec section 12): each body of a scene becomes a lattice of nodes at cell
 // centres, sized so that the lattice fills the body's length exactly.
 
+#include <array>
 #include <cstddef>
 #include <vector>
 
@@ -19,6 +20,24 @@ std::size_t add_body_nodes(NodeStore& nodes, const Scene& scene, std::size_t bod
 
 // The lattice a body is filled with (exposed for tests and reports).
 LatticeBlock body_lattice(const Scene& scene, std::size_t body);
+
+// A node of a body filled with rings (CellFill::Rings): its place in the body's own axes (the
+// cylinder's base centre at 0, its axis along z, before the body's rotation and origin) and its
+// volume.
+struct RingNode {
+    std::array<double, 3> position{};
+    double volume = 0.0;
+};
+
+// The rings that fill cylinder or plate b (CellFill::Rings): layers of height hz = length / nz,
+// nz = round(length / spacing); in each layer M = round(R_k / spacing) rings of width w = R_k / M
+// at radii (m + 1/2) w, with a multiple of 4 of nodes n_m near 2 pi r_m / spacing at the angles
+// (q + 1/2) 2 pi / n_m, each node the n_m-th part of its annulus. R_k is the radius of the
+// cylinder of the layer's volume (a nose's layers from its profile, integrated), so the nodes hold
+// the shape's volume; a layer thinner than half a spacing across (a cone's tip) is one node on the
+// axis. The rings are mirror images of themselves across the planes x = 0 and y = 0, and no node
+// lies on the axis or on those planes, as a 2D axisymmetric lattice has no node on its axis.
+std::vector<RingNode> ring_fill(const BodySpec& b);
 
 // The initial volumetric strain that puts the equation of state of `material` at pressure p
 // (e = 0): how a body's initial mean stress becomes an initial compression (particles and

@@ -72,8 +72,11 @@ std::string_view name_of(Discretisation d);
 // How a lattice fills a shape's boundary cells (docs/scene-format.md, `fill`): `Centres` keeps the
 // cells whose centre lies inside (the staircase of the paper's lattices); `Trimmed` makes every
 // cell the shape covers in part a node of that part (its centroid, its volume), slivers merged
-// into a neighbour (LatticeBlock::trim): the body's outline and mass are the shape's.
-enum class CellFill { Centres, Trimmed };
+// into a neighbour (LatticeBlock::trim): the body's outline and mass are the shape's. `Rings`
+// (3D cylinders and plates, variable connectivity) has no cubic lattice: layers along the axis,
+// each of concentric rings of nodes about it (bodies.hpp, ring_fill), so that the body has no
+// lattice directions across its section, as the 2D axisymmetric discretisation has none.
+enum class CellFill { Centres, Trimmed, Rings };
 
 // The shaped end of a cylinder: a projectile's nose (Borvik et al. fired blunt, hemispherical and
 // conical ones; tangent ogives are the usual long-rod and bullet shape). The nose is part of the
