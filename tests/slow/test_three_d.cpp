@@ -77,9 +77,11 @@ TEST(ThreeD, TheSteelBarAt343MetresPerSecondAgreesWithTwoDAtMatchedSpacing) {
 // The shipped 3D scenes of copper 190, steel 208 and the paper's cylinder (nodal viscosity) at
 // their 8 nodes across the radius against the 2D scenes at the same spacing, the 3D ones as quarters.
 // Measured (2026-12-05): copper length +0.01 %, footprint -1.2 %, peak +0.2 %; steel +0.04 %,
-// +0.44 %, -1.0 %; the cylinder -0.37 %, +1.1 %, +3.8 %; widest over narrowest 1.027, 1.018 and
-// 1.018. With the damping on the lattice regime alone the 3D footprints grow with refinement, to
-// +8 % over 2D at 16 across (docs/validation.md, "The face pairs in the hoop direction").
+// +0.44 %, -1.0 %; widest over narrowest 1.027 and 1.018. The cylinder, filled with rings since
+// 2026-12-07 (docs/validation.md, "3D: rings about the axis"): -0.06 %, +0.29 %, +3.8 %, 1.010
+// (its cubic trimmed fill gave -0.37 %, +1.1 %, +3.8 %, 1.018). With the damping on the lattice
+// regime alone the 3D footprints grow with refinement, to +8 % over 2D at 16 across
+// (docs/validation.md, "The face pairs in the hoop direction").
 TEST(ThreeD, TheCopperAndSteelBarsAndThePapersCylinderAgreeWithTwoDAtTheShippedSpacing) {
     expect_agreement(run(scene_file("taylor-copper-190-3d-quarter.toml", 1.0), "copper 190, 3D quarter"),
                      run(damped_everywhere(scene_file("taylor-copper-190.toml", 8.0 / 15.0)), "copper 190, 2D"));
