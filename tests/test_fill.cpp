@@ -217,8 +217,9 @@ TEST(RingFill, RingsHoldTheCylindersVolumeAndAreTheirOwnMirrorImages) {
 
 // A nose's layers take their volume from its profile (Simpson's rule on each layer), against a
 // midpoint sum of 2 10^5 slices: measured -1.9e-7 (the cone: the kink at its base inside a layer),
-// 1.3e-10 (hemisphere) and -4.1e-11 (ogive) at 8 across. A layer with its shank's volume instead
-// would be off by a large part of a layer's share (1/24 of the body here).
+// 1.3e-10 (hemisphere) and -4.1e-11 (ogive) at 8 across, the centroid within 6e-8 of the length,
+// the smallest node 0.29-0.66 of a cell. A layer with its shank's volume instead would be off by a
+// large part of a layer's share (1/24 of the body here).
 TEST(RingFill, ANosedCylinderHoldsItsVolume) {
     const double R = 5.1e-3, L = 15.2e-3, s = R / 8.0;
     Scene scene = ring_body(R, L, s);
@@ -227,16 +228,32 @@ TEST(RingFill, ANosedCylinderHoldsItsVolume) {
         SCOPED_TRACE(static_cast<int>(kind));
         b.nose = NoseSpec{kind, kind == NoseKind::Cone ? 4e-3 : 0.0, kind == NoseKind::Ogive ? 1.5 : 0.0, -1};
         validate_scene(scene);
-        double exact = 0.0;
+        double exact = 0.0, exact_moment = 0.0;
         constexpr int steps = 200000;
         for (int k = 0; k < steps; ++k) {
-            const double r = cylinder_radius_at(b, (k + 0.5) * L / steps);
+            const double z = (k + 0.5) * L / steps;
+            const double r = cylinder_radius_at(b, z);
             exact += pi * r * r * L / steps;
+            exact_moment += z * pi * r * r * L / steps;
         }
         const std::vector<RingNode> rings = ring_fill(b);
         const double v = total_volume(rings);
-        std::printf("[ measured ] ring fill of a nosed cylinder: volume off by %.2g\n", v / exact - 1.0);
+        double moment = 0.0, smallest = v;
+        for (const RingNode& n : rings) {
+            moment += n.position[2] * n.volume;
+            smallest = std::min(smallest, n.volume);
+            // No node on the axis or the planes x = 0, y = 0 (the tip's thin layers joined a larger one).
+            EXPECT_GT(std::min(std::abs(n.position[0]), std::abs(n.position[1])), 0.05 * s);
+        }
+        std::printf("[ measured ] ring fill of a nosed cylinder: volume off by %.2g, centroid by %.2g of the length, "
+                    "smallest node %.3g of a cell\n",
+                    v / exact - 1.0, (moment / v - exact_moment / exact) / L, smallest / (s * s * s));
         EXPECT_NEAR(v / exact, 1.0, 2e-6);
+        // Each layer's nodes sit at its slice's centroid: the body's centroid to Simpson's accuracy.
+        EXPECT_NEAR(moment / v, exact_moment / exact, 1e-6 * L);
+        // A layer joined to its neighbour once its radius is below half a spacing: its 4 nodes hold at
+        // least pi (s/2)^2 times its height over 4, a fifth of a cell.
+        EXPECT_GT(smallest, 0.19 * s * s * (L / std::round(L / s)));
         for (const RingNode& n : rings) EXPECT_LE(std::hypot(n.position[0], n.position[1]), cylinder_radius_at(b, n.position[2]) + 1e-12);
     }
 }

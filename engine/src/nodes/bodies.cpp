@@ -236,31 +236,54 @@ std::vector<RingNode> ring_fill(const BodySpec& b) {
         throw InputError(fmt::format("body \"{}\": radius {} m must be positive", b.name, b.radius));
     }
     checked_cells(std::round(b.radius / spacing), b.name, "radius");
-    std::vector<RingNode> out;
+    // The layers along the axis: height, volume and the height of the volume's centroid.
+    struct Layer {
+        double height = 0.0, volume = 0.0, centroid = 0.0;
+    };
+    std::vector<Layer> slabs;
     for (std::int64_t k = 0; k < layers; ++k) {
         const double bottom = static_cast<double>(k) * height;
-        const double middle = bottom + 0.5 * height;
-        // The layer's volume: pi R^2 height along the shank; over a nose, pi r(z)^2 integrated by
-        // Simpson's rule on 64 intervals, exact where r^2 is quadratic in z (the cone, the
-        // hemisphere) but for the kink at the nose's base within a layer (tests/test_fill.cpp
-        // measured the body's volume off by 2e-7 with a cone, 1e-10 with the other noses).
-        double volume = std::numbers::pi * b.radius * b.radius * height;
+        Layer layer{height, std::numbers::pi * b.radius * b.radius * height, bottom + 0.5 * height};
         if (b.nose) {
+            // Over a nose, pi r(z)^2 and z pi r(z)^2 integrated by Simpson's rule on 64 intervals:
+            // exact where r^2 is quadratic in z (the cone, the hemisphere) but for the kink at the
+            // nose's base within a layer (tests/test_fill.cpp measured the body's volume off by
+            // 2e-7 with a cone, 1e-10 with the other noses).
             constexpr int intervals = 64;
-            const auto area = [&](double z) {
+            double volume = 0.0, moment = 0.0;
+            for (int q = 0; q <= intervals; ++q) {
+                const double z = bottom + height * q / intervals;
                 const double r = cylinder_radius_at(b, z);
-                return std::numbers::pi * r * r;
-            };
-            double sum = area(bottom) + area(bottom + height);
-            for (int q = 1; q < intervals; ++q) sum += (q % 2 ? 4.0 : 2.0) * area(bottom + height * q / intervals);
-            volume = sum * height / (3.0 * intervals);
+                const double weight = q == 0 || q == intervals ? 1.0 : (q % 2 ? 4.0 : 2.0);
+                volume += weight * std::numbers::pi * r * r;
+                moment += weight * z * std::numbers::pi * r * r;
+            }
+            layer.volume = volume * height / (3.0 * intervals);
+            layer.centroid = layer.volume > 0.0 ? moment * height / (3.0 * intervals) / layer.volume : layer.centroid;
         }
-        if (!(volume > 0.0)) continue;
-        const double radius = std::sqrt(volume / (std::numbers::pi * height));  // the layer's equivalent cylinder
-        if (radius < 0.5 * spacing) {
-            out.push_back({{0.0, 0.0, middle}, volume});  // a tip: one node on the axis
+        if (layer.volume > 0.0) slabs.push_back(layer);
+    }
+    // A layer less than half a spacing in radius (the last of a cone or an ogive) joins its larger
+    // neighbour, so that no ring is a sliver (a small d0 would shorten the stable step).
+    const auto thin = [&](const Layer& l) { return l.volume < std::numbers::pi * 0.25 * spacing * spacing * l.height; };
+    for (std::size_t k = 0; slabs.size() > 1 && k < slabs.size();) {
+        if (!thin(slabs[k])) {
+            ++k;
             continue;
         }
+        const std::size_t other = k == 0 ? 1 : k + 1 == slabs.size() ? k - 1 : (slabs[k - 1].volume > slabs[k + 1].volume ? k - 1 : k + 1);
+        Layer& into = slabs[other];
+        const Layer& from = slabs[k];
+        into.centroid = (into.centroid * into.volume + from.centroid * from.volume) / (into.volume + from.volume);
+        into.volume += from.volume;
+        into.height += from.height;
+        slabs.erase(slabs.begin() + static_cast<std::ptrdiff_t>(k));
+        k = 0;
+    }
+    std::vector<RingNode> out;
+    for (const Layer& layer : slabs) {
+        // Rings over the radius of the cylinder of the layer's volume and height.
+        const double radius = std::sqrt(layer.volume / (std::numbers::pi * layer.height));
         const auto rings = static_cast<int>(std::max(1.0, std::round(radius / spacing)));
         const double width = radius / rings;
         for (int m = 0; m < rings; ++m) {
@@ -269,10 +292,10 @@ std::vector<RingNode> ring_fill(const BodySpec& b) {
             // 2 pi / count the ring is its own mirror image across x = 0 and y = 0 with no node on
             // either (an even count that is not a multiple of 4 puts a node on x = 0).
             const int count = 4 * std::max(1, static_cast<int>(std::lround(0.5 * std::numbers::pi * r / spacing)));
-            const double each = std::numbers::pi * (2 * m + 1) * width * width * height / count;
+            const double each = std::numbers::pi * (2 * m + 1) * width * width * layer.height / count;
             for (int q = 0; q < count; ++q) {
                 const double angle = (q + 0.5) * 2.0 * std::numbers::pi / count;
-                out.push_back({{r * std::cos(angle), r * std::sin(angle), middle}, each});
+                out.push_back({{r * std::cos(angle), r * std::sin(angle), layer.centroid}, each});
             }
         }
     }

@@ -33,10 +33,11 @@ struct RingNode {
 // nz = round(length / spacing); in each layer M = round(R_k / spacing) rings of width w = R_k / M
 // at radii (m + 1/2) w, with a multiple of 4 of nodes n_m near 2 pi r_m / spacing at the angles
 // (q + 1/2) 2 pi / n_m, each node the n_m-th part of its annulus. R_k is the radius of the
-// cylinder of the layer's volume (a nose's layers from its profile, integrated), so the nodes hold
-// the shape's volume; a layer thinner than half a spacing across (a cone's tip) is one node on the
-// axis. The rings are mirror images of themselves across the planes x = 0 and y = 0, and no node
-// lies on the axis or on those planes, as a 2D axisymmetric lattice has no node on its axis.
+// cylinder of the layer's volume (a nose's layers from its profile, integrated, at the height of
+// their centroid), so the nodes hold the shape's volume; a layer less than half a spacing in radius
+// (a cone's tip) joins its larger neighbour. The rings are mirror images of themselves across the
+// planes x = 0 and y = 0, and no node lies on the axis or on those planes, as a 2D axisymmetric
+// lattice has no node on its axis.
 std::vector<RingNode> ring_fill(const BodySpec& b);
 
 // The initial volumetric strain that puts the equation of state of `material` at pressure p
