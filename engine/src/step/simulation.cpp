@@ -826,6 +826,66 @@ CheckpointInfo read_header(StateReader& in) {
 
 }  // namespace
 
+namespace {
+
+// The run's clock as a checkpoint keeps it, listed once for writing (IO = StateWriter, Impl const)
+// and reading (StateReader).
+template <class IO, class Impl>
+void clock_fields(IO& io, Impl& s) {
+    io.field(s.time);
+    io.field(s.dt_half);
+    io.field(s.dt_next);
+    io.field(s.steps);
+    io.field(s.node_steps);
+    io.field(s.element_steps);
+}
+
+// What a checkpoint keeps of the totals, listed once for both directions (T = const Totals or
+// Totals); `planes` and `regions` are the scene's counts, which a checkpoint read must hold. The
+// rest of Totals (the bodies' reports, local peaks, base height) is measured again after a resume.
+template <class IO, class T>
+void totals_fields(IO& io, T& t, std::size_t planes, std::size_t regions) {
+    for (auto* v : {&t.time, &t.time_step, &t.kinetic_energy, &t.internal_energy, &t.plastic_work, &t.viscous_work,
+                    &t.boundary_work, &t.initial_kinetic_energy, &t.initial_energy, &t.energy_error, &t.momentum[0],
+                    &t.momentum[1], &t.momentum[2], &t.length, &t.footprint_diameter, &t.footprint_narrowest,
+                    &t.footprint_widest, &t.hourglass_work, &t.hourglass_energy, &t.energy_given, &t.external_work}) {
+        io.field(*v);
+    }
+    for (auto* v : {&t.step, &t.real_nodes, &t.ghost_nodes, &t.variable_nodes, &t.failed_nodes, &t.pairs,
+                    &t.neighbour_searches, &t.row_searches, &t.rows_searched}) {
+        io.field(*v);
+    }
+    io.sequence(t.planes, planes, "its planes are not the scene's");
+    for (auto& p : t.planes) {
+        io.field(p.name);
+        io.field(p.reaction);
+        io.field(p.impulse);
+    }
+    io.sequence(t.regions, regions, "its prescribed velocities are not the scene's");
+    for (auto& r : t.regions) {
+        io.field(r.name);
+        io.field(r.nodes);
+        for (int c = 0; c < 3; ++c) {
+            io.field(r.held[c]);
+            for (auto* v : {&r.velocity[c], &r.displacement[c], &r.reaction[c], &r.impulse[c]}) io.field(*v);
+        }
+        io.field(r.work);
+    }
+}
+
+// The phases' accumulated times, both directions; `phases` is this scene's phase count.
+template <class IO, class Times>
+void phase_time_fields(IO& io, Times& times, std::size_t phases) {
+    io.sequence(times, phases, "its phase list is not this scene's");
+    for (auto& p : times) {
+        io.field(p.name);
+        io.field(p.seconds);
+        io.field(p.calls);
+    }
+}
+
+}  // namespace
+
 void Simulation::Impl::write_state(StateWriter& out) const {
     out.tag("SIMU");
     nodes.write_state(out);
@@ -834,12 +894,7 @@ void Simulation::Impl::write_state(StateWriter& out) const {
     neighbour_lists.write_state(out, dim());
     out.tag("TIME");
     out.array(largest_bond_q);
-    out.value<double>(time);
-    out.value<double>(dt_half);
-    out.value<double>(dt_next);
-    out.value<std::uint64_t>(steps);
-    out.value<double>(node_steps);
-    out.value<double>(element_steps);
+    clock_fields(out, *this);
     out.value<std::uint64_t>(totals.bodies.size());
     for (const auto& b : totals.bodies) out.value<double>(b.kinetic_energy);
     rigid_planes.write_state(out);
@@ -849,39 +904,9 @@ void Simulation::Impl::write_state(StateWriter& out) const {
     external.write_state(out, scene.prescribed_velocities);
     if (elements) elements->write_state(out);
     out.tag("TOTL");
-    const Totals& t = totals;
-    for (const double v : {t.time, t.time_step, t.kinetic_energy, t.internal_energy, t.plastic_work, t.viscous_work,
-                           t.boundary_work, t.initial_kinetic_energy, t.initial_energy, t.energy_error, t.momentum[0],
-                           t.momentum[1], t.momentum[2], t.length, t.footprint_diameter, t.footprint_narrowest, t.footprint_widest, t.hourglass_work, t.hourglass_energy, t.energy_given, t.external_work}) {
-        out.value<double>(v);
-    }
-    for (const std::size_t v : {t.step, t.real_nodes, t.ghost_nodes, t.variable_nodes, t.failed_nodes, t.pairs,
-                                t.neighbour_searches, t.row_searches, t.rows_searched}) {
-        out.value<std::uint64_t>(v);
-    }
-    out.value<std::uint64_t>(t.planes.size());
-    for (const auto& p : t.planes) {
-        out.text(p.name);
-        out.value<double>(p.reaction);
-        out.value<double>(p.impulse);
-    }
-    out.value<std::uint64_t>(t.regions.size());
-    for (const auto& r : t.regions) {
-        out.text(r.name);
-        out.value<std::uint64_t>(r.nodes);
-        for (int c = 0; c < 3; ++c) {
-            out.value<std::uint8_t>(r.held[c]);
-            for (const double v : {r.velocity[c], r.displacement[c], r.reaction[c], r.impulse[c]}) out.value<double>(v);
-        }
-        out.value<double>(r.work);
-    }
+    totals_fields(out, totals, rigid_planes.size(), scene.prescribed_velocities.size());
     const auto times = graph->times();
-    out.value<std::uint64_t>(times.size());
-    for (const auto& p : times) {
-        out.text(p.name);
-        out.value<double>(p.seconds);
-        out.value<std::uint64_t>(p.calls);
-    }
+    phase_time_fields(out, times, times.size());
     out.tag("END.");
 }
 
@@ -897,12 +922,7 @@ void Simulation::Impl::read_state(StateReader& in) {
     switching_part.forget_lattice_axes();  // found again from the restored nodes
     in.tag("TIME");
     in.array(largest_bond_q);
-    time = in.value<double>();
-    dt_half = in.value<double>();
-    dt_next = in.value<double>();
-    steps = static_cast<std::size_t>(in.value<std::uint64_t>());
-    node_steps = in.value<double>();
-    element_steps = in.value<double>();
+    clock_fields(in, *this);
     std::vector<double> body_kinetic(static_cast<std::size_t>(in.value<std::uint64_t>()));
     if (body_kinetic.size() != scene.bodies.size()) in.fail("its bodies are not the scene's");
     for (double& k : body_kinetic) k = in.value<double>();
@@ -912,45 +932,10 @@ void Simulation::Impl::read_state(StateReader& in) {
     regions.read_state(in);
     external.read_state(in, scene.prescribed_velocities, real);
     if (elements) elements->read_state(in);
-    const std::size_t region_count = scene.prescribed_velocities.size();
     in.tag("TOTL");
-    Totals& t = totals;
-    for (double* v : {&t.time, &t.time_step, &t.kinetic_energy, &t.internal_energy, &t.plastic_work, &t.viscous_work,
-                      &t.boundary_work, &t.initial_kinetic_energy, &t.initial_energy, &t.energy_error, &t.momentum[0],
-                      &t.momentum[1], &t.momentum[2], &t.length, &t.footprint_diameter, &t.footprint_narrowest, &t.footprint_widest, &t.hourglass_work, &t.hourglass_energy, &t.energy_given, &t.external_work}) {
-        *v = in.value<double>();
-    }
-    for (std::size_t* v : {&t.step, &t.real_nodes, &t.ghost_nodes, &t.variable_nodes, &t.failed_nodes, &t.pairs,
-                           &t.neighbour_searches, &t.row_searches, &t.rows_searched}) {
-        *v = static_cast<std::size_t>(in.value<std::uint64_t>());
-    }
-    const auto planes = in.value<std::uint64_t>();
-    if (planes != rigid_planes.size()) in.fail("its planes are not the scene's");
-    t.planes.resize(static_cast<std::size_t>(planes));
-    for (auto& p : t.planes) {
-        p.name = in.text();
-        p.reaction = in.value<double>();
-        p.impulse = in.value<double>();
-    }
-    if (in.value<std::uint64_t>() != region_count) in.fail("its prescribed velocities are not the scene's");
-    t.regions.resize(region_count);
-    for (auto& r : t.regions) {
-        r.name = in.text();
-        r.nodes = static_cast<std::size_t>(in.value<std::uint64_t>());
-        for (int c = 0; c < 3; ++c) {
-            r.held[c] = in.value<std::uint8_t>() != 0;
-            for (double* v : {&r.velocity[c], &r.displacement[c], &r.reaction[c], &r.impulse[c]}) *v = in.value<double>();
-        }
-        r.work = in.value<double>();
-    }
-    const auto phase_count = in.value<std::uint64_t>();
-    if (phase_count > 1000) in.fail("its phase list is damaged");
-    std::vector<PhaseTime> times(static_cast<std::size_t>(phase_count));
-    for (auto& p : times) {
-        p.name = in.text();
-        p.seconds = in.value<double>();
-        p.calls = static_cast<std::size_t>(in.value<std::uint64_t>());
-    }
+    totals_fields(in, totals, rigid_planes.size(), scene.prescribed_velocities.size());
+    std::vector<PhaseTime> times;
+    phase_time_fields(in, times, graph->times().size());
     graph->restore_times(times);
     in.tag("END.");
     regroup_materials();

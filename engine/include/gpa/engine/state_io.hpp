@@ -64,6 +64,18 @@ public:
     // A section mark: four letters.
     void tag(std::string_view name) { bytes(name.data(), 4); }
 
+    // One field of a list that StateReader reads back with the same calls (a part's fields listed
+    // once, for both directions: template <class IO> void fields(IO& io, Part& p) { io.field(p.x); }).
+    void field(double v) { value(v); }
+    void field(std::size_t v) { value<std::uint64_t>(v); }
+    void field(bool v) { value<std::uint8_t>(v ? 1 : 0); }
+    void field(const std::string& s) { text(s); }
+    // A sequence's length, ahead of its elements (StateReader::sequence checks it).
+    template <class Vector>
+    void sequence(const Vector& v, std::size_t /*expected*/, std::string_view /*what*/) {
+        value<std::uint64_t>(v.size());
+    }
+
     std::uint64_t checksum() const { return checksum_.value(); }
     bool good() const { return static_cast<bool>(out_); }
 
@@ -120,6 +132,19 @@ public:
         if (std::string_view(got, 4) != name.substr(0, 4)) {
             fail("section \"" + std::string(name) + "\" is missing (a damaged checkpoint, or one of another format)");
         }
+    }
+
+    // The fields StateWriter::field wrote, read into place.
+    void field(double& v) { v = value<double>(); }
+    void field(std::size_t& v) { v = static_cast<std::size_t>(value<std::uint64_t>()); }
+    void field(bool& v) { v = value<std::uint8_t>() != 0; }
+    void field(std::string& s) { s = text(); }
+    // A sequence's length: it must be `expected` (the scene's count), else the checkpoint is
+    // refused naming `what` ("its planes are not the scene's"); the sequence is resized to it.
+    template <class Vector>
+    void sequence(Vector& v, std::size_t expected, std::string_view what) {
+        if (value<std::uint64_t>() != expected) fail(std::string(what));
+        v.resize(expected);
     }
 
     [[noreturn]] void fail(const std::string& what) const { throw CheckpointError("checkpoint " + source_ + ": " + what); }
