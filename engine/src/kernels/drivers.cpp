@@ -387,17 +387,43 @@ void stress_power_impl(const CompressedRows& lists, const ForceFields<G::dim>& f
             KeptDampingPower<D, CurvedDamping> damping;
             if (hourglass) damping = KeptDampingPower<D, CurvedDamping>(*hourglass, i, n, hourglass_coefficient);
             double damping_power = 0.0;
+            // The bond-viscous forces' power (StressPowerOut::bond), their Q_ij made from the force
+            // pass's velocities with its arithmetic (forces_impl), so that the forces are the same.
+            const BondViscosityParameters* const bond = out.bond;
+            double bond_power = 0.0;
+            [[maybe_unused]] double density = 0.0, sound_speed = 0.0;
+            Vec<D> bond_v_i = Vec<D>::Zero();
+            if (bond) {
+                density = f.mass[i] / volume;
+                sound_speed = f.sound_speed[i];
+                for (int c = 0; c < D; ++c) bond_v_i[c] = out.bond_velocity[c][i];
+            }
             const std::size_t first = lists.offsets[i];
             const auto row = lists.row(i);
             for (std::size_t k = 0; k < row.size(); ++k) {
                 const NodeIndex j = row[k];
                 const auto p = f.pairs.template pair<W>(i, j, first + k);
                 Vec<D> dv = load<D>(velocity, j) - v_i;
-                if (f.pairs.sliding(i, j)) {
-                    dv = along_pair<D>(f.pairs.sliding_normal(i, j, PairFields<D>::direction(p.dx)), dv);  // spec section 2
+                const bool sliding = f.pairs.sliding(i, j);
+                [[maybe_unused]] Vec<D> normal;
+                if (sliding) {
+                    normal = f.pairs.sliding_normal(i, j, PairFields<D>::direction(p.dx));
+                    dv = along_pair<D>(normal, dv);  // spec section 2
                 }
                 accumulate_velocity_difference<D>(p, f.size_weight[j], dv, difference);
                 if (damping.active()) damping_power += damping.term(*hourglass, j, p.dx, n);
+                if (bond) {
+                    // Eq. 37-38 as forces_impl makes them (the whole pair: it reads r and h), the
+                    // -Q_ij part of Eq. 21-22's pair force, its power at this pass's velocities.
+                    const auto whole = f.pairs.template pair<W>(i, j);
+                    Vec<D> dv_force;
+                    for (int c = 0; c < D; ++c) dv_force[c] = out.bond_velocity[c][j] - bond_v_i[c];
+                    if (sliding) dv_force = along_pair<D>(normal, dv_force);
+                    const double mu = bond_compression_rate(whole, dv_force, bond->eps0);
+                    const double bond_q = bond_viscosity(mu, density, sound_speed, bond->linear, bond->quadratic);
+                    const Vec<D> normalised_dx = f.full_normalisation ? Vec<D>(normalisation * whole.dx) : Vec<D>(normalisation.diagonal().cwiseProduct(whole.dx));
+                    bond_power += whole.R_over_r2 * volume * f.size_weight[j] * bond_q * normalised_dx.dot(dv);
+                }
             }
             double sum = -volume * (sigma * normalisation).cwiseProduct(difference).sum();  // Eq. 21-22 summed over j
             double divergence = normalisation.cwiseProduct(difference).sum();
@@ -416,6 +442,7 @@ void stress_power_impl(const CompressedRows& lists, const ForceFields<G::dim>& f
                 out.power[i] = sum;
                 out.viscous_power[i] = viscous;
             }
+            if (bond) out.bond_power[i] = bond_power;
             if (hourglass) {
                 hourglass->power[i] = damping_power;
                 if (hourglass->stiffness_power) {

@@ -23,6 +23,7 @@ EnergyLedger::EnergyLedger(const SolverOptions& solver)
     // its internal energy follows the point update's own energy equation.
     : compatible_(solver.energy_update == EnergyUpdate::Compatible && solver.force_form == ForceForm::Pairwise),
       bond_(solver.viscosity == ViscosityKind::Bond),
+      bond_parameters_{solver.viscosity_linear, solver.viscosity_quadratic, solver.bond_viscosity_eps0},
       hourglass_(solver.hourglass_coefficient > 0.0 || solver.hourglass_stiffness > 0.0),
       stiffness_(solver.hourglass_stiffness > 0.0),
       damping_(solver.hourglass_coefficient > 0.0),
@@ -57,7 +58,7 @@ void EnergyLedger::keep_hourglass_fits(HourglassFields<D>& control, std::size_t 
 }
 
 void EnergyLedger::keep_half_step_velocities(const NodeStore& nodes) {
-    if (!(compatible_ && hourglass_)) return;
+    if (!(compatible_ && (hourglass_ || bond_))) return;
     // Ghosts included (their mirrored velocities): the control pairs the ghosts that continue a body
     // across a symmetry plane (hourglass.hpp, ghost_continues), and the booking reads them too.
     for (int c = 0; c < nodes.dim(); ++c) half_velocity_[c].assign(nodes.velocity[c].begin(), nodes.velocity[c].end());
@@ -118,6 +119,14 @@ void EnergyLedger::compatible_powers(const CompressedRows& lists, WeightKind wei
     booking.viscous_work = nodes.viscous_work.data();
     booking.mass = nodes.mass.data();
     booking.dt = dt_avg;
+    if (bond_) {
+        // The bond-viscous forces' work at the mean velocities (their Q_ij from the half-step
+        // velocities the force pass made them with), in place of the force pass's power at v^{n+1/2}:
+        // exactly the kinetic energy they take out in this update.
+        booking.bond = &bond_parameters_;
+        for (int c = 0; c < D; ++c) booking.bond_velocity[c] = half_velocity_[c].data();
+        booking.bond_power = bond_power_.data();
+    }
     compute_stress_power<G>(lists, weight, forces, mean, real, booking, control ? &*control : nullptr, hourglass_coefficient);
 }
 

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "gpa/engine/compressed_rows.hpp"
+#include "gpa/engine/drivers.hpp"
 #include "gpa/engine/fields.hpp"
 #include "gpa/engine/ghosts.hpp"
 #include "gpa/engine/hourglass.hpp"
@@ -47,16 +48,18 @@ public:
     template <int D>
     void keep_hourglass_fits(HourglassFields<D>& control, std::size_t count);
 
-    // Before the velocity update: v^{n+1/2} of the real nodes, from which the force pass made the
-    // hourglass forces (their power is taken at the mean velocities later). Only when needed.
+    // Before the velocity update: v^{n+1/2} of the nodes, from which the force pass made the
+    // hourglass and bond-viscous forces (their power is taken at the mean velocities later). Only
+    // when needed.
     void keep_half_step_velocities(const NodeStore& nodes);
 
     // After the velocity update and the prescribed components (compatible update only): the work of
-    // each centre's stress forces and, with the hourglass control, of its control forces at the mean
-    // velocities v_mean = v^{n+3/2} - dt_avg F / (2 M) (held components: the mean of their two half
+    // each centre's stress forces and, with bond viscosity or the hourglass control, of those forces
+    // at the mean velocities v_mean = v^{n+3/2} - dt_avg F / (2 M) (held components: the mean of their two half
     // steps; ghosts mirrored), in one visit of every row (drivers.hpp, compute_stress_power). The
     // stress work and its nodal-viscosity share are booked into the nodes in that visit, the first
-    // of the step's bookings (book() does the rest); the control's powers go to the ledger's arrays.
+    // of the step's bookings (book() does the rest); the bond-viscous and the control's powers go to
+    // the ledger's arrays, replacing the force pass's.
     // `forces` and `control` are the fields of the force pass (control: none without the control;
     // its velocities and outputs are set here: the kept half-step velocities, the ledger's arrays).
     template <class G>
@@ -83,6 +86,7 @@ public:
 private:
     bool compatible_ = true;
     bool bond_ = false;
+    BondViscosityParameters bond_parameters_;  // C_L, C_Q, eps0 of the scene (with bond_)
     bool hourglass_ = false;
     bool stiffness_ = false;
     bool damping_ = false;  // the hourglass control's damping form (C_hg > 0)

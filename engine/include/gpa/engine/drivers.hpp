@@ -72,6 +72,13 @@ struct StressPowerOut {
     double* viscous_work = nullptr;
     const double* mass = nullptr;
     double dt = 0.0;
+    // Bond viscosity (Eq. 37-38), optional: each pair's Q_ij made again as the force pass made it,
+    // from `bond_velocity` (the velocities of the force pass), and the power of its forces at the
+    // pass's `velocity` into bond_power[i], per real centre (the compatible booking of the
+    // bond-viscous work, spec section 5). Needs the force fields' mass and sound speed.
+    const BondViscosityParameters* bond = nullptr;
+    std::array<const double*, 3> bond_velocity{};
+    double* bond_power = nullptr;
 };
 template <class G>
 void compute_stress_power(const CompressedRows& lists, WeightKind weight, const ForceFields<G::dim>& f,
