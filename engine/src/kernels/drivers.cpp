@@ -4,6 +4,7 @@
 #include <atomic>
 #include <cstdint>
 #include <limits>
+#include <type_traits>
 
 #include <Eigen/Eigenvalues>
 #include <fmt/format.h>
@@ -365,8 +366,8 @@ void stress_difference_impl(const CompressedRows& lists, const ScatterPlan& plan
 }
 
 // `CurvedDamping`: the hourglass damping's kept fits may have second derivatives (the quadratic
-// fit; KeptDampingPower), chosen once for the pass.
-template <class G, class W, bool CurvedDamping>
+// fit; KeptDampingPower), chosen once for the pass; `WithBond`: StressPowerOut::bond is set.
+template <class G, class W, bool CurvedDamping, bool WithBond>
 void stress_power_impl(const CompressedRows& lists, const ForceFields<G::dim>& f,
                        const std::array<const double*, G::dim>& velocity, std::size_t n, const StressPowerOut& out,
                        const HourglassFields<G::dim>* hourglass, double hourglass_coefficient) {
@@ -389,11 +390,10 @@ void stress_power_impl(const CompressedRows& lists, const ForceFields<G::dim>& f
             double damping_power = 0.0;
             // The bond-viscous forces' power (StressPowerOut::bond), their Q_ij made from the force
             // pass's velocities with its arithmetic (forces_impl), so that the forces are the same.
-            const BondViscosityParameters* const bond = out.bond;
-            double bond_power = 0.0;
-            [[maybe_unused]] double density = 0.0, sound_speed = 0.0;
-            Vec<D> bond_v_i = Vec<D>::Zero();
-            if (bond) {
+            [[maybe_unused]] const BondViscosityParameters* const bond = out.bond;
+            [[maybe_unused]] double bond_power = 0.0, density = 0.0, sound_speed = 0.0;
+            [[maybe_unused]] Vec<D> bond_v_i;
+            if constexpr (WithBond) {
                 density = f.mass[i] / volume;
                 sound_speed = f.sound_speed[i];
                 for (int c = 0; c < D; ++c) bond_v_i[c] = out.bond_velocity[c][i];
@@ -412,7 +412,7 @@ void stress_power_impl(const CompressedRows& lists, const ForceFields<G::dim>& f
                 }
                 accumulate_velocity_difference<D>(p, f.size_weight[j], dv, difference);
                 if (damping.active()) damping_power += damping.term(*hourglass, j, p.dx, n);
-                if (bond) {
+                if constexpr (WithBond) {
                     // Eq. 37-38 as forces_impl makes them (the whole pair: it reads r and h), the
                     // -Q_ij part of Eq. 21-22's pair force, its power at this pass's velocities.
                     const auto whole = f.pairs.template pair<W>(i, j);
@@ -442,7 +442,7 @@ void stress_power_impl(const CompressedRows& lists, const ForceFields<G::dim>& f
                 out.power[i] = sum;
                 out.viscous_power[i] = viscous;
             }
-            if (bond) out.bond_power[i] = bond_power;
+            if constexpr (WithBond) out.bond_power[i] = bond_power;
             if (hourglass) {
                 hourglass->power[i] = damping_power;
                 if (hourglass->stiffness_power) {
@@ -471,10 +471,15 @@ void compute_stress_power(const CompressedRows& lists, WeightKind weight, const 
         throw InputError("compute_stress_power: no place for the powers (both arrays, or the energies, viscous work and masses)");
     }
     dispatch_weight(weight, [&](auto w) {
-        if (hourglass && hourglass->quadratic) {
-            stress_power_impl<G, decltype(w), true>(lists, f, velocity, real_count, out, hourglass, hourglass_coefficient);
+        const auto run = [&](auto curved, auto with_bond) {
+            stress_power_impl<G, decltype(w), decltype(curved)::value, decltype(with_bond)::value>(lists, f, velocity, real_count, out,
+                                                                                                 hourglass, hourglass_coefficient);
+        };
+        const bool curved = hourglass && hourglass->quadratic;
+        if (out.bond) {
+            curved ? run(std::true_type{}, std::true_type{}) : run(std::false_type{}, std::true_type{});
         } else {
-            stress_power_impl<G, decltype(w), false>(lists, f, velocity, real_count, out, hourglass, hourglass_coefficient);
+            curved ? run(std::true_type{}, std::false_type{}) : run(std::false_type{}, std::false_type{});
         }
     });
 }
