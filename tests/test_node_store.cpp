@@ -131,10 +131,15 @@ TEST(Kernels, ArtificialViscosityActsOnlyInCompression) {
                      0.2 * 1000.0 * 5000.0 * 0.001 * 1e4 + 4.0 * 1000.0 * 1e-6 * 1e8);
     EXPECT_EQ(bond_viscosity(0.5, 1000.0, 5000.0, 0.2, 4.0), 0.0);
     EXPECT_DOUBLE_EQ(bond_viscosity(-2.0, 1000.0, 5000.0, 0.2, 4.0), 0.2 * 1000.0 * 5000.0 * 2.0 + 4.0 * 1000.0 * 4.0);
-    // Eq. 38: approaching nodes have mu < 0.
-    PairGeometry<2> p{Vec<2>(1.0, 0.0), 0.002, 1.0 / 0.002, 0.001, 0.0, Vec<2>(0.002, 0.0), 0.0};
-    EXPECT_LT(bond_compression_rate(p, Vec<2>(-1.0, 0.0).eval(), 0.01), 0.0);
-    EXPECT_NEAR(bond_compression_rate(p, Vec<2>(-1.0, 0.0).eval(), 0.01), -0.001 * 0.002 / (0.002 * 0.002 + 0.01 * 1e-6), 1e-15);
+    // Eq. 38: approaching nodes have mu < 0, receding ones mu > 0 (h 1 mm, the pair 2 mm apart
+    // along x, closing at 1 m/s; the same along a diagonal, where only the projection counts).
+    const Vec<2> dx(0.002, 0.0);
+    EXPECT_LT(bond_compression_rate<2>(0.001, dx, Vec<2>(-1.0, 0.0), 0.01), 0.0);
+    EXPECT_GT(bond_compression_rate<2>(0.001, dx, Vec<2>(1.0, 0.0), 0.01), 0.0);
+    EXPECT_NEAR(bond_compression_rate<2>(0.001, dx, Vec<2>(-1.0, 0.0), 0.01), -0.001 * 0.002 / (0.002 * 0.002 + 0.01 * 1e-6), 1e-15);
+    const Vec<2> diagonal(0.002 / std::sqrt(2.0), 0.002 / std::sqrt(2.0));
+    EXPECT_NEAR(bond_compression_rate<2>(0.001, diagonal, Vec<2>(-1.0, 3.0), 0.01),
+                0.001 * (2.0 * 0.002 / std::sqrt(2.0)) / (0.002 * 0.002 + 0.01 * 1e-6), 1e-15);
 }
 
 TEST(Kernels, WeightsVanishAtTwoH) {

@@ -270,8 +270,7 @@ void forces_impl(const CompressedRows& lists, const ScatterPlan& plan, const Bon
         const auto row = lists.row(i);
         for (std::size_t k = 0; k < row.size(); ++k) {
             const NodeIndex j = row[k];
-            // The bond viscosity reads r and h, which the kept pairs leave out (fields.hpp).
-            const auto p = with_bond_viscosity ? f.pairs.template pair<W>(i, j) : f.pairs.template pair<W>(i, j, first + k);
+            const auto p = f.pairs.template pair<W>(i, j, first + k);
             const bool sliding = f.pairs.sliding(i, j);  // spec section 2: one direction only
             // The contact normal, read only when sliding (a kept pair has no l: its direction made).
             [[maybe_unused]] const Vec<D> n = sliding ? f.pairs.sliding_normal(i, j, PairFields<D>::direction(p.dx)) : Vec<D>::Zero().eval();
@@ -280,7 +279,8 @@ void forces_impl(const CompressedRows& lists, const ScatterPlan& plan, const Bon
             if constexpr (with_bond_viscosity) {
                 dv = load<D>(f.velocity, j) - v_i;
                 if (sliding) dv = along_pair<D>(n, dv);
-                const double mu = bond_compression_rate(p, dv, bond.eps0);  // Eq. 38
+                const double h = pair_smoothing_length(f.pairs.influence_distance, f.pairs.diameter[i], f.pairs.diameter[j]);
+                const double mu = bond_compression_rate<D>(h, p.dx, dv, bond.eps0);  // Eq. 38
                 q = bond_viscosity(mu, density, sound_speed, bond.linear, bond.quadratic);  // Eq. 37
             }
             Vec<D> normalised_dx;
@@ -413,16 +413,16 @@ void stress_power_impl(const CompressedRows& lists, const ForceFields<G::dim>& f
                 accumulate_velocity_difference<D>(p, f.size_weight[j], dv, difference);
                 if (damping.active()) damping_power += damping.term(*hourglass, j, p.dx, n);
                 if constexpr (WithBond) {
-                    // Eq. 37-38 as forces_impl makes them (the whole pair: it reads r and h), the
-                    // -Q_ij part of Eq. 21-22's pair force, its power at this pass's velocities.
-                    const auto whole = f.pairs.template pair<W>(i, j);
+                    // Eq. 37-38 as forces_impl makes them, the -Q_ij part of Eq. 21-22's pair force,
+                    // its power at this pass's velocities.
                     Vec<D> dv_force;
                     for (int c = 0; c < D; ++c) dv_force[c] = out.bond_velocity[c][j] - bond_v_i[c];
                     if (sliding) dv_force = along_pair<D>(normal, dv_force);
-                    const double mu = bond_compression_rate(whole, dv_force, bond->eps0);
+                    const double h = pair_smoothing_length(f.pairs.influence_distance, f.pairs.diameter[i], f.pairs.diameter[j]);
+                    const double mu = bond_compression_rate<D>(h, p.dx, dv_force, bond->eps0);
                     const double bond_q = bond_viscosity(mu, density, sound_speed, bond->linear, bond->quadratic);
-                    const Vec<D> normalised_dx = f.full_normalisation ? Vec<D>(normalisation * whole.dx) : Vec<D>(normalisation.diagonal().cwiseProduct(whole.dx));
-                    bond_power += whole.R_over_r2 * volume * f.size_weight[j] * bond_q * normalised_dx.dot(dv);
+                    const Vec<D> normalised_dx = f.full_normalisation ? Vec<D>(normalisation * p.dx) : Vec<D>(normalisation.diagonal().cwiseProduct(p.dx));
+                    bond_power += p.R_over_r2 * volume * f.size_weight[j] * bond_q * normalised_dx.dot(dv);
                 }
             }
             double sum = -volume * (sigma * normalisation).cwiseProduct(difference).sum();  // Eq. 21-22 summed over j

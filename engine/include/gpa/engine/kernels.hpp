@@ -259,11 +259,12 @@ inline std::array<double, 2> cylindrical_divergence_terms(double sigma_xx, doubl
     return {volume * (sigma_xx - sigma_theta) / radius, volume * sigma_xz / radius};
 }
 
-// Eq. 38: mu_ij = h_ij (v_i - v_j).(x_i - x_j) / (r^2 + eps0 h_ij^2), with
-// (v_i - v_j).(x_i - x_j) = r (v_j - v_i).l.
+// Eq. 38: mu_ij = h_ij (v_i - v_j).(x_i - x_j) / (r^2 + eps0 h_ij^2), as the paper writes it, from
+// dx = x_j - x_i and dv = v_j - v_i (whose product is (v_i - v_j).(x_i - x_j)): no square root, so
+// that the force pass and the energy booking make it from a kept pair (fields.hpp) and h_ij alone.
 template <int D>
-inline double bond_compression_rate(const PairGeometry<D>& p, const Vec<D>& dv, double eps0) {
-    return p.h * p.r * dv.dot(p.l) / (p.r * p.r + eps0 * p.h * p.h);
+inline double bond_compression_rate(double h, const Vec<D>& dx, const Vec<D>& dv, double eps0) {
+    return h * dv.dot(dx) / (dx.squaredNorm() + eps0 * h * h);
 }
 
 // Eq. 37: Q_ij = C_L rho_i c_i |mu| + C_Q rho_i mu^2 for mu < 0, otherwise 0.
