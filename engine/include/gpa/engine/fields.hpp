@@ -122,8 +122,9 @@ struct PairFields {
     std::size_t kept_rows = 0;
 
     // pair<W>(i, j) of list entry `entry` of centre i, from the kept term where there is one. A
-    // kept pair has only dx and R / r^2 (the rest NaN): a kernel that reads r and h (the bond
-    // viscosity, Eq. 38) calls pair(i, j), and one that needs l takes direction(dx).
+    // kept pair has only dx and R / r^2 (the rest NaN): a kernel that reads r calls pair(i, j), one
+    // that needs h_ij makes it from the diameters (the bond viscosity, Eq. 38), and one that needs
+    // l takes direction(dx).
     template <class VariableWeight>
     PairGeometry<D> pair(std::size_t i, std::size_t j, std::size_t entry) const {
         if (i >= kept_rows) return pair<VariableWeight>(i, j);
