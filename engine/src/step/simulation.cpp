@@ -824,10 +824,6 @@ CheckpointInfo read_header(StateReader& in) {
     return info;
 }
 
-}  // namespace
-
-namespace {
-
 // The run's clock as a checkpoint keeps it, listed once for writing (IO = StateWriter, Impl const)
 // and reading (StateReader).
 template <class IO, class Impl>
