@@ -595,31 +595,28 @@ std::vector<double> GhostSet::normal_reactions(const NodeStore& nodes, std::size
     return reaction;
 }
 
-void GhostSet::write_state(StateWriter& out) const {
-    out.tag("GHST");
-    out.value<std::uint64_t>(planes_.size());
-    out.value<std::uint64_t>(masks_.size());
-    out.array(source_);
-    out.array(mask_);
-    out.array(slot_);
-    out.array(sources_sorted_);
-    out.value<std::uint64_t>(table_real_count_);
-    out.array(ghost_table_);
-    out.value<std::uint8_t>(keep_between_searches_ ? 1 : 0);
-    write_rows(out, resolved_);
+template <class IO, class Self>
+void GhostSet::state_fields(IO& io, Self& self, std::size_t real_count, std::size_t node_count) {
+    io.tag("GHST");
+    io.expect(self.planes_.size(), "its planes are not the scene's");
+    io.expect(self.masks_.size(), "its planes are not the scene's");
+    io.field(self.source_);
+    io.field(self.mask_);
+    io.field(self.slot_);
+    io.field(self.sources_sorted_);
+    io.field(self.table_real_count_);
+    io.field(self.ghost_table_);
+    io.field(self.keep_between_searches_);
+    io.field(self.resolved_.offsets);
+    io.field(self.resolved_.indices);
+    if constexpr (IO::reading) self.check_restored(io, real_count, node_count);
 }
 
-void GhostSet::read_state(StateReader& in, std::size_t real_count, std::size_t node_count) {
-    in.tag("GHST");
-    if (in.value<std::uint64_t>() != planes_.size() || in.value<std::uint64_t>() != masks_.size()) {
-        in.fail("its planes are not the scene's");
-    }
-    in.array(source_);
-    in.array(mask_);
-    in.array(slot_);
-    in.array(sources_sorted_);
-    table_real_count_ = static_cast<std::size_t>(in.value<std::uint64_t>());
-    in.array(ghost_table_);
+void GhostSet::write_state(StateWriter& out) const { state_fields(out, *this, 0, 0); }
+void GhostSet::read_state(StateReader& in, std::size_t real_count, std::size_t node_count) { state_fields(in, *this, real_count, node_count); }
+
+// What a checkpoint's ghosts must satisfy (read_state, once every field is read).
+void GhostSet::check_restored(StateReader& in, std::size_t real_count, std::size_t node_count) const {
     const std::size_t ghosts = source_.size();
     if (mask_.size() != ghosts || slot_.size() != ghosts || real_count + ghosts != node_count) {
         in.fail("its ghosts do not match its nodes (a damaged checkpoint)");
@@ -648,9 +645,6 @@ void GhostSet::read_state(StateReader& in, std::size_t real_count, std::size_t n
         ++listed;
     }
     if (listed != ghosts) in.fail("a ghost table leaves out some ghosts (a damaged checkpoint)");
-    keep_between_searches_ = in.value<std::uint8_t>() != 0;
-    in.array(resolved_.offsets);
-    in.array(resolved_.indices);
     if (resolved_.offsets.empty() || resolved_.offsets.back() != resolved_.indices.size()) {
         in.fail("the resolved mirror lists are damaged");
     }

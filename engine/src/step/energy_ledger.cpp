@@ -186,21 +186,17 @@ void EnergyLedger::memory_use(MemoryUse& out) const {
     add_memory(out, "energy ledger: hourglass fits of the force pass", fits);
 }
 
-void EnergyLedger::write_state(StateWriter& out) const {
-    out.tag("ENRG");
-    out.value<double>(boundary_work_);
-    out.value<double>(hourglass_work_);
-    out.value<double>(hourglass_energy_);
-    out.array(bond_power_);
+template <class IO, class Self>
+void EnergyLedger::state_fields(IO& io, Self& self) {
+    io.tag("ENRG");
+    io.field(self.boundary_work_);
+    io.field(self.hourglass_work_);
+    io.field(self.hourglass_energy_);
+    io.field(self.bond_power_);
 }
 
-void EnergyLedger::read_state(StateReader& in) {
-    in.tag("ENRG");
-    boundary_work_ = in.value<double>();
-    hourglass_work_ = in.value<double>();
-    hourglass_energy_ = in.value<double>();
-    in.array(bond_power_);
-}
+void EnergyLedger::write_state(StateWriter& out) const { state_fields(out, *this); }
+void EnergyLedger::read_state(StateReader& in) { state_fields(in, *this); }
 
 template void EnergyLedger::compatible_powers<PlaneStrain>(const CompressedRows&, WeightKind, const ForceFields<2>&,
                                                            std::optional<HourglassFields<2>>, double, NodeStore&, std::size_t,

@@ -84,6 +84,10 @@ public:
     void read_state(StateReader& in);
 
 private:
+    // The checkpoint's fields, listed once for both directions (Self const when writing).
+    template <class IO, class Self>
+    static void state_fields(IO& io, Self& self);
+
     bool compatible_ = true;
     bool bond_ = false;
     BondViscosityParameters bond_parameters_;  // C_L, C_Q, eps0 of the scene (with bond_)

@@ -82,53 +82,57 @@ void ExternalLoads::memory_use(MemoryUse& out) const {
     add_memory(out, "external loads: node ids", allocated_bytes(index_of_id_));
 }
 
-void ExternalLoads::write_state(StateWriter& out, const std::vector<PrescribedVelocitySpec>& regions) const {
-    out.tag("EXTL");
-    out.value<std::uint64_t>(pending_.size());
-    for (const Load& l : pending_) {
-        out.value<std::uint32_t>(l.id);
-        for (const double f : l.force) out.value<double>(f);
+template <class IO, class Self, class Regions>
+void ExternalLoads::state_fields(IO& io, Self& self, Regions& regions, std::size_t real) {
+    io.tag("EXTL");
+    std::size_t count = self.pending_.size();
+    io.field(count);
+    if constexpr (IO::reading) {
+        constexpr std::uint64_t bytes_per_load = 4 + 3 * 8;
+        if (count > io.left() / bytes_per_load || count > real) io.fail("its external loads are damaged");
+        self.pending_.assign(count, {});
     }
-    out.value<double>(work_);
-    out.value<double>(last_force_work_);
-    out.value<std::uint64_t>(regions.size());
-    for (const auto& r : regions) {
-        for (const auto& v : r.velocity) {
-            out.value<std::uint8_t>(v.has_value());
-            out.value<double>(v.value_or(0.0));
+    for (auto& l : self.pending_) {
+        io.field(l.id);
+        if constexpr (IO::reading) {
+            if (l.id >= real) io.fail("an external load names a node the scene does not have");
         }
-        out.value<double>(r.ramp);
+        for (auto& f : l.force) {
+            io.field(f);
+            if constexpr (IO::reading) {
+                if (!std::isfinite(f)) io.fail("an external load is not finite");
+            }
+        }
+    }
+    io.field(self.work_);
+    io.field(self.last_force_work_);
+    io.expect(regions.size(), "its prescribed-velocity regions are not the scene's");
+    for (auto& r : regions) {
+        for (int c = 0; c < 3; ++c) {
+            const bool scene_holds = r.velocity[c].has_value();
+            bool held = scene_holds;
+            double v = r.velocity[c].value_or(0.0);
+            io.field(held);
+            io.field(v);
+            if constexpr (IO::reading) {
+                if (held != scene_holds) io.fail(fmt::format("region \"{}\" holds other components than the scene's", r.name));
+                if (held && !std::isfinite(v)) io.fail(fmt::format("region \"{}\" has a velocity that is not finite", r.name));
+                if (held) r.velocity[c] = v;
+            }
+        }
+        io.field(r.ramp);
+        if constexpr (IO::reading) {
+            if (!(r.ramp >= 0.0) || !std::isfinite(r.ramp)) io.fail(fmt::format("region \"{}\" has a ramp that is damaged", r.name));
+        }
     }
 }
 
+void ExternalLoads::write_state(StateWriter& out, const std::vector<PrescribedVelocitySpec>& regions) const {
+    state_fields(out, *this, regions, 0);
+}
+
 void ExternalLoads::read_state(StateReader& in, std::vector<PrescribedVelocitySpec>& regions, std::size_t real) {
-    in.tag("EXTL");
-    const auto count = in.value<std::uint64_t>();
-    constexpr std::uint64_t bytes_per_load = 4 + 3 * 8;
-    if (count > in.left() / bytes_per_load || count > real) in.fail("its external loads are damaged");
-    pending_.assign(static_cast<std::size_t>(count), {});
-    for (Load& l : pending_) {
-        l.id = in.value<std::uint32_t>();
-        if (l.id >= real) in.fail("an external load names a node the scene does not have");
-        for (double& f : l.force) {
-            f = in.value<double>();
-            if (!std::isfinite(f)) in.fail("an external load is not finite");
-        }
-    }
-    work_ = in.value<double>();
-    last_force_work_ = in.value<double>();
-    if (in.value<std::uint64_t>() != regions.size()) in.fail("its prescribed-velocity regions are not the scene's");
-    for (auto& r : regions) {
-        for (int c = 0; c < 3; ++c) {
-            const bool held = in.value<std::uint8_t>() != 0;
-            const double v = in.value<double>();
-            if (held != r.velocity[c].has_value()) in.fail(fmt::format("region \"{}\" holds other components than the scene's", r.name));
-            if (held && !std::isfinite(v)) in.fail(fmt::format("region \"{}\" has a velocity that is not finite", r.name));
-            if (held) r.velocity[c] = v;
-        }
-        r.ramp = in.value<double>();
-        if (!(r.ramp >= 0.0) || !std::isfinite(r.ramp)) in.fail(fmt::format("region \"{}\" has a ramp that is damaged", r.name));
-    }
+    state_fields(in, *this, regions, real);
 }
 
 }  // namespace gpa

@@ -72,6 +72,11 @@ public:
     void read_state(StateReader& in, std::vector<PrescribedVelocitySpec>& regions, std::size_t real);
 
 private:
+    // The checkpoint's fields, listed once for both directions (Self and Regions const when
+    // writing; `real` bounds the loads' ids when reading).
+    template <class IO, class Self, class Regions>
+    static void state_fields(IO& io, Self& self, Regions& regions, std::size_t real);
+
     struct Load {
         std::uint32_t id = 0;
         std::array<double, 3> force{0, 0, 0};

@@ -396,16 +396,17 @@ void Measures::local_fields(const Scene& scene, const NodeStore& nodes, std::siz
     out.face_roughness = measure::face_roughness(face_across, face_value);
     out.face_points = face_value.size();
 }
-void Measures::write_state(StateWriter& out) const {
-    out.tag("MEAS");
-    out.value<double>(kinetic_half_);
-    out.array(body_kinetic_half_);
+template <class IO, class Self>
+void Measures::state_fields(IO& io, Self& self) {
+    io.tag("MEAS");
+    io.field(self.kinetic_half_);
+    io.field(self.body_kinetic_half_);
 }
 
+void Measures::write_state(StateWriter& out) const { state_fields(out, *this); }
+
 void Measures::read_state(StateReader& in, std::size_t bodies) {
-    in.tag("MEAS");
-    kinetic_half_ = in.value<double>();
-    in.array(body_kinetic_half_);
+    state_fields(in, *this);
     if (body_kinetic_half_.size() != bodies) in.fail("its bodies are not the scene's");
 }
 

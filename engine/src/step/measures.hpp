@@ -75,6 +75,10 @@ public:
     void read_state(StateReader& in, std::size_t bodies);
 
 private:
+    // The checkpoint's fields, listed once for both directions (Self const when writing).
+    template <class IO, class Self>
+    static void state_fields(IO& io, Self& self);
+
     // The symmetry planes bodies reach (set_up), and of them those that stand on `plane`, one per
     // axis: a node's images across them belong to the body's extent (measure.hpp).
     std::vector<GhostPlane> mirrors_on(const GhostPlane& plane) const;

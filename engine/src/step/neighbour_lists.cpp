@@ -25,24 +25,24 @@ PositionView positions_of(const NodeStore& n) {
     return v;
 }
 
-void write_plan(StateWriter& out, const ScatterPlan& plan) {
-    out.value<std::int32_t>(static_cast<std::int32_t>(plan.scheme));
-    out.array(plan.colour_offsets);
-    out.array(plan.group_offsets);
-    out.array(plan.centres);
-}
-
-void read_plan(StateReader& in, ScatterPlan& plan, std::size_t node_count) {
-    plan.scheme = static_cast<ScatterScheme>(in.value<std::int32_t>());
-    in.array(plan.colour_offsets);
-    in.array(plan.group_offsets);
-    in.array(plan.centres);
-    const bool fits = !plan.colour_offsets.empty() && !plan.group_offsets.empty() &&
-                      plan.colour_offsets.back() <= plan.group_offsets.size() - 1 &&
-                      plan.group_offsets.back() <= plan.centres.size();
-    if (!fits) in.fail("its scatter plan is damaged");
-    for (const NodeIndex c : plan.centres) {
-        if (c >= node_count) in.fail("its scatter plan names a node that does not exist");
+// A scatter plan in a checkpoint, both directions (Plan const when writing); read, it must name
+// only nodes below `node_count`.
+template <class IO, class Plan>
+void plan_fields(IO& io, Plan& plan, std::size_t node_count) {
+    auto scheme = static_cast<std::int32_t>(plan.scheme);
+    io.field(scheme);
+    io.field(plan.colour_offsets);
+    io.field(plan.group_offsets);
+    io.field(plan.centres);
+    if constexpr (IO::reading) {
+        plan.scheme = static_cast<ScatterScheme>(scheme);
+        const bool fits = !plan.colour_offsets.empty() && !plan.group_offsets.empty() &&
+                          plan.colour_offsets.back() <= plan.group_offsets.size() - 1 &&
+                          plan.group_offsets.back() <= plan.centres.size();
+        if (!fits) io.fail("its scatter plan is damaged");
+        for (const NodeIndex c : plan.centres) {
+            if (c >= node_count) io.fail("its scatter plan names a node that does not exist");
+        }
     }
 }
 
@@ -492,51 +492,41 @@ void NeighbourLists::refresh_plan(const NodeStore& nodes) {
     plan_due_ = false;
 }
 
-void NeighbourLists::write_state(StateWriter& out, int dim) const {
-    out.tag("LIST");
-    write_rows(out, lists_);
-    out.value<std::uint8_t>(search_due_);
-    out.value<std::uint8_t>(plan_due_);
-    out.value<double>(skin_);
-    out.value<double>(searched_range_);
-    out.value<std::uint64_t>(searches_);
-    write_rows(out, candidates_);
-    out.array(lattice_entries_);
-    out.array(quiet_);
-    out.array(searched_fixed_);
-    for (int c = 0; c < dim; ++c) out.array(searched_position_[c]);
-    out.array(searched_diameter_);
-    out.value<std::uint8_t>(rows_searched_alone_);
-    out.value<std::uint64_t>(row_searches_);
-    out.value<std::uint64_t>(rows_searched_);
-    out.value<std::uint64_t>(full_search_entries_);
-    write_plan(out, plan_);
+template <class IO, class Self>
+void NeighbourLists::state_fields(IO& io, Self& self, int dim, std::size_t node_count) {
+    constexpr std::size_t any_rows = std::numeric_limits<std::size_t>::max();
+    io.tag("LIST");
+    rows_field(io, self.lists_, any_rows, node_count);
+    io.field(self.search_due_);
+    io.field(self.plan_due_);
+    io.field(self.skin_);
+    io.field(self.searched_range_);
+    io.field(self.searches_);
+    rows_field(io, self.candidates_, any_rows, node_count);
+    io.field(self.lattice_entries_);
+    io.field(self.quiet_);
+    io.field(self.searched_fixed_);
+    if constexpr (IO::reading) {
+        if (self.quiet_.size() != self.searched_fixed_.size() ||
+            (!self.lattice_entries_.empty() && self.quiet_.size() != self.lattice_entries_.size())) {
+            io.fail("its neighbour lists are damaged");
+        }
+    }
+    for (int c = 0; c < dim; ++c) io.field(self.searched_position_[c]);
+    io.field(self.searched_diameter_);
+    io.field(self.rows_searched_alone_);
+    io.field(self.row_searches_);
+    io.field(self.rows_searched_);
+    io.field(self.full_search_entries_);
+    plan_fields(io, self.plan_, node_count);
 }
+
+void NeighbourLists::write_state(StateWriter& out, int dim) const { state_fields(out, *this, dim, 0); }
 
 void NeighbourLists::read_state(StateReader& in, int dim, std::size_t node_count) {
     kept_rows_ = 0;  // the restored lists are not those the terms were kept for
-    in.tag("LIST");
-    read_rows(in, lists_, std::numeric_limits<std::size_t>::max(), node_count);
-    search_due_ = in.value<std::uint8_t>() != 0;
-    plan_due_ = in.value<std::uint8_t>() != 0;
-    skin_ = in.value<double>();
-    searched_range_ = in.value<double>();
-    searches_ = static_cast<std::size_t>(in.value<std::uint64_t>());
-    read_rows(in, candidates_, std::numeric_limits<std::size_t>::max(), node_count);
-    in.array(lattice_entries_);
-    in.array(quiet_);
-    in.array(searched_fixed_);
+    state_fields(in, *this, dim, node_count);
     any_quiet_ = std::find(quiet_.begin(), quiet_.end(), std::uint8_t{1}) != quiet_.end();
-    if (quiet_.size() != searched_fixed_.size() || (!lattice_entries_.empty() && quiet_.size() != lattice_entries_.size())) {
-        in.fail("its neighbour lists are damaged");
-    }
-    for (int c = 0; c < dim; ++c) in.array(searched_position_[c]);
-    in.array(searched_diameter_);
-    rows_searched_alone_ = in.value<std::uint8_t>() != 0;
-    row_searches_ = static_cast<std::size_t>(in.value<std::uint64_t>());
-    rows_searched_ = static_cast<std::size_t>(in.value<std::uint64_t>());
-    full_search_entries_ = static_cast<std::size_t>(in.value<std::uint64_t>());
-    read_plan(in, plan_, node_count);
 }
 
 void NeighbourLists::memory_use(MemoryUse& out) const {

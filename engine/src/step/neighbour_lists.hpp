@@ -107,6 +107,10 @@ public:
     void read_state(StateReader& in, int dim, std::size_t node_count);
 
 private:
+    // The checkpoint's fields, listed once for both directions (Self const when writing).
+    template <class IO, class Self>
+    static void state_fields(IO& io, Self& self, int dim, std::size_t node_count);
+
     // What the geometry phase learns of the candidates: whether the ghosts still cover every
     // node within reach of a plane, whether the bound of the last full search still holds (every
     // reference from one moment; the displacements measured from their middle), and the largest

@@ -119,35 +119,26 @@ double Regions::report(double time, bool at_half_step, bool at_start, std::vecto
     return work_now;
 }
 
-void Regions::write_state(StateWriter& out) const {
-    out.tag("PVEL");
-    out.array(work_);
-    for (std::size_t k = 0; k < work_.size(); ++k) {
+template <class IO, class Self>
+void Regions::state_fields(IO& io, Self& self) {
+    io.tag("PVEL");
+    io.field(self.work_);
+    if constexpr (IO::reading) {
+        if (self.work_.size() != self.specs_->size()) io.fail("its prescribed velocities are not the scene's");
+    }
+    for (std::size_t k = 0; k < self.work_.size(); ++k) {
         for (int c = 0; c < 3; ++c) {
-            out.value<double>(last_[k].reaction[c]);
-            out.value<double>(impulse_[k][c]);
-            out.value<double>(displacement_[k][c]);
-            out.value<double>(last_[k].velocity[c]);
+            io.field(self.last_[k].reaction[c]);
+            io.field(self.impulse_[k][c]);
+            io.field(self.displacement_[k][c]);
+            io.field(self.last_[k].velocity[c]);
         }
-        out.value<double>(last_[k].work);
+        io.field(self.last_[k].work);
     }
 }
 
-void Regions::read_state(StateReader& in) {
-    in.tag("PVEL");
-    in.array(work_);
-    const std::size_t regions = specs_->size();
-    if (work_.size() != regions) in.fail("its prescribed velocities are not the scene's");
-    for (std::size_t k = 0; k < regions; ++k) {
-        for (int c = 0; c < 3; ++c) {
-            last_[k].reaction[c] = in.value<double>();
-            impulse_[k][c] = in.value<double>();
-            displacement_[k][c] = in.value<double>();
-            last_[k].velocity[c] = in.value<double>();
-        }
-        last_[k].work = in.value<double>();
-    }
-}
+void Regions::write_state(StateWriter& out) const { state_fields(out, *this); }
+void Regions::read_state(StateReader& in) { state_fields(in, *this); }
 
 void Regions::check_restored(StateReader& in, const NodeStore& nodes, std::size_t real) {
     const std::size_t regions = specs_->size();

@@ -64,6 +64,10 @@ public:
     void check_restored(StateReader& in, const NodeStore& nodes, std::size_t real);
 
 private:
+    // The checkpoint's fields, listed once for both directions (Self const when writing).
+    template <class IO, class Self>
+    static void state_fields(IO& io, Self& self);
+
     const std::vector<PrescribedVelocitySpec>* specs_;
     // A scene is all particles or all elements, so one of the two sets of held nodes is empty.
     HeldNodes held_particles_, held_elements_;

@@ -159,22 +159,17 @@ void RigidPlanes::report(const GhostSet& ghosts, const std::vector<double>* elem
     }
 }
 
-void RigidPlanes::write_state(StateWriter& out) const {
-    out.array(impulse_);
-    out.array(reaction_);
-    out.array(friction_work_);
-    out.array(pressing_impulse_);
-}
-
-void RigidPlanes::read_state(StateReader& in) {
-    in.array(impulse_);
-    in.array(reaction_);
-    in.array(friction_work_);
-    in.array(pressing_impulse_);
-    if (impulse_.size() != ghost_plane_.size() || reaction_.size() != ghost_plane_.size() ||
-        friction_work_.size() != ghost_plane_.size() || pressing_impulse_.size() != ghost_plane_.size()) {
-        in.fail("its planes are not the scene's");
+template <class IO, class Self>
+void RigidPlanes::state_fields(IO& io, Self& self) {
+    for (auto* array : {&self.impulse_, &self.reaction_, &self.friction_work_, &self.pressing_impulse_}) {
+        io.field(*array);
+        if constexpr (IO::reading) {
+            if (array->size() != self.ghost_plane_.size()) io.fail("its planes are not the scene's");
+        }
     }
 }
+
+void RigidPlanes::write_state(StateWriter& out) const { state_fields(out, *this); }
+void RigidPlanes::read_state(StateReader& in) { state_fields(in, *this); }
 
 }  // namespace gpa

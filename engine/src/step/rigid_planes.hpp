@@ -68,6 +68,10 @@ public:
     void read_state(StateReader& in);
 
 private:
+    // The checkpoint's fields, listed once for both directions (Self const when writing).
+    template <class IO, class Self>
+    static void state_fields(IO& io, Self& self);
+
     struct FrictionForce {
         NodeIndex node;
         std::size_t plane;                // index among the rigid planes

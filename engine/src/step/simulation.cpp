@@ -6,6 +6,7 @@
 #include <limits>
 #include <numeric>
 #include <optional>
+#include <sstream>
 #include <utility>
 
 #include <fmt/format.h>
@@ -880,60 +881,71 @@ void phase_time_fields(IO& io, Times& times, std::size_t phases) {
     }
 }
 
+// A part's section in the direction of IO: write_state(out), or read_state(in, read_args...).
+template <class IO, class Part, class... ReadArgs>
+void part_state(IO& io, Part& part, ReadArgs&&... read_args) {
+    if constexpr (IO::reading) {
+        part.read_state(io, std::forward<ReadArgs>(read_args)...);
+    } else {
+        part.write_state(io);
+    }
+}
+
+// The checkpoint's sections in their order, listed once for writing (IO = StateWriter, Impl
+// const) and reading. Returns the bodies' kinetic energies of the half step as read (the reader
+// puts them into the totals once the bodies are measured again; empty when writing).
+template <class IO, class Impl>
+std::vector<double> state_sections(IO& io, Impl& s) {
+    constexpr bool reading = IO::reading;
+    io.tag("SIMU");
+    part_state(io, s.nodes);
+    io.expect(s.real, "its bodies hold another number of nodes than the scene's");
+    const std::size_t n = s.nodes.size();
+    if constexpr (reading) {
+        if (n < s.real) io.fail("it holds fewer nodes than the scene's bodies (a damaged checkpoint)");
+    }
+    part_state(io, s.ghosts, s.real, n);
+    if constexpr (reading) {
+        s.neighbour_lists.read_state(io, s.dim(), n);
+        s.switching_part.forget_lattice_axes();  // found again from the restored nodes
+    } else {
+        s.neighbour_lists.write_state(io, s.dim());
+    }
+    io.tag("TIME");
+    io.field(s.largest_bond_q);
+    clock_fields(io, s);
+    std::vector<double> body_kinetic;
+    if constexpr (!reading) {
+        for (const auto& b : s.totals.bodies) body_kinetic.push_back(b.kinetic_energy);
+    }
+    io.sequence(body_kinetic, s.scene.bodies.size(), "its bodies are not the scene's");
+    for (double& k : body_kinetic) io.field(k);
+    part_state(io, s.rigid_planes);
+    part_state(io, s.measures, s.scene.bodies.size());
+    part_state(io, s.ledger);
+    part_state(io, s.regions);
+    if constexpr (reading) {
+        s.external.read_state(io, s.scene.prescribed_velocities, s.real);
+    } else {
+        s.external.write_state(io, s.scene.prescribed_velocities);
+    }
+    if (s.elements) part_state(io, *s.elements);
+    io.tag("TOTL");
+    totals_fields(io, s.totals, s.rigid_planes.size(), s.scene.prescribed_velocities.size());
+    auto times = s.graph->times();
+    phase_time_fields(io, times, times.size());
+    if constexpr (reading) s.graph->restore_times(times);
+    io.tag("END.");
+    return body_kinetic;
+}
+
 }  // namespace
 
-void Simulation::Impl::write_state(StateWriter& out) const {
-    out.tag("SIMU");
-    nodes.write_state(out);
-    out.value<std::uint64_t>(real);
-    ghosts.write_state(out);
-    neighbour_lists.write_state(out, dim());
-    out.tag("TIME");
-    out.array(largest_bond_q);
-    clock_fields(out, *this);
-    out.value<std::uint64_t>(totals.bodies.size());
-    for (const auto& b : totals.bodies) out.value<double>(b.kinetic_energy);
-    rigid_planes.write_state(out);
-    measures.write_state(out);
-    ledger.write_state(out);
-    regions.write_state(out);
-    external.write_state(out, scene.prescribed_velocities);
-    if (elements) elements->write_state(out);
-    out.tag("TOTL");
-    totals_fields(out, totals, rigid_planes.size(), scene.prescribed_velocities.size());
-    const auto times = graph->times();
-    phase_time_fields(out, times, times.size());
-    out.tag("END.");
-}
+void Simulation::Impl::write_state(StateWriter& out) const { state_sections(out, *this); }
 
 void Simulation::Impl::read_state(StateReader& in) {
     external.forget_ids();  // until the nodes are read whole: no id is found in a half-read store
-    in.tag("SIMU");
-    nodes.read_state(in);
-    if (in.value<std::uint64_t>() != real) in.fail("its bodies hold another number of nodes than the scene's");
-    const std::size_t n = nodes.size();
-    if (n < real) in.fail("it holds fewer nodes than the scene's bodies (a damaged checkpoint)");
-    ghosts.read_state(in, real, n);
-    neighbour_lists.read_state(in, dim(), n);
-    switching_part.forget_lattice_axes();  // found again from the restored nodes
-    in.tag("TIME");
-    in.array(largest_bond_q);
-    clock_fields(in, *this);
-    std::vector<double> body_kinetic(static_cast<std::size_t>(in.value<std::uint64_t>()));
-    if (body_kinetic.size() != scene.bodies.size()) in.fail("its bodies are not the scene's");
-    for (double& k : body_kinetic) k = in.value<double>();
-    rigid_planes.read_state(in);
-    measures.read_state(in, scene.bodies.size());
-    ledger.read_state(in);
-    regions.read_state(in);
-    external.read_state(in, scene.prescribed_velocities, real);
-    if (elements) elements->read_state(in);
-    in.tag("TOTL");
-    totals_fields(in, totals, rigid_planes.size(), scene.prescribed_velocities.size());
-    std::vector<PhaseTime> times;
-    phase_time_fields(in, times, graph->times().size());
-    graph->restore_times(times);
-    in.tag("END.");
+    const std::vector<double> body_kinetic = state_sections(in, *this);
     regroup_materials();
     measures.body_totals(scene, nodes, real, false, nullptr, totals.bodies);
     for (std::size_t b = 0; b < body_kinetic.size(); ++b) totals.bodies[b].kinetic_energy = body_kinetic[b];
@@ -945,21 +957,40 @@ void Simulation::Impl::read_state(StateReader& in) {
 
 bool Simulation::can_checkpoint() const { return true; }
 
-void Simulation::save_checkpoint(std::ostream& out, std::string_view scene_fingerprint, std::string_view user_data) const {
-    if (impl_->failed) throw NumericalError("Simulation::save_checkpoint: the last step failed and left the state half-updated");
-    StateWriter w(out);
+namespace {
+
+// A checkpoint's header and sections, without the checksum that ends the file.
+template <class Impl>
+void write_checkpoint(StateWriter& w, const Impl& impl, std::string_view scene_fingerprint, std::string_view user_data) {
     w.bytes(checkpoint_magic, sizeof checkpoint_magic);
-    w.value<std::uint32_t>(checkpoint_format);
+    w.value<std::uint32_t>(Simulation::checkpoint_format);
     w.value<std::uint32_t>(byte_order_mark);
     w.text(build_id());
     w.text(scene_fingerprint);
-    w.text(impl_->scene.name);
-    w.value<std::uint64_t>(impl_->steps);
-    w.value<double>(impl_->time);
+    w.text(impl.scene.name);
+    w.value<std::uint64_t>(impl.steps);
+    w.value<double>(impl.time);
     w.text(user_data);
-    impl_->write_state(w);
+    impl.write_state(w);
+}
+
+}  // namespace
+
+void Simulation::save_checkpoint(std::ostream& out, std::string_view scene_fingerprint, std::string_view user_data) const {
+    if (impl_->failed) throw NumericalError("Simulation::save_checkpoint: the last step failed and left the state half-updated");
+    StateWriter w(out);
+    write_checkpoint(w, *impl_, scene_fingerprint, user_data);
     const std::uint64_t sum = w.checksum();
     out.write(reinterpret_cast<const char*>(&sum), sizeof sum);
+}
+
+std::vector<std::uint64_t> Simulation::checkpoint_field_starts(std::string_view scene_fingerprint, std::string_view user_data) const {
+    std::ostringstream discarded;
+    StateWriter w(discarded);
+    std::vector<std::uint64_t> starts;
+    w.record_field_starts(&starts);
+    write_checkpoint(w, *impl_, scene_fingerprint, user_data);
+    return starts;
 }
 
 CheckpointInfo Simulation::checkpoint_info(std::istream& in, std::uint64_t size, const std::string& source) {

@@ -208,6 +208,11 @@ public:
     void memory_use(MemoryUse& out) const;
 
 private:
+    // The checkpoint's fields, listed once for both directions (Self const when writing).
+    template <class IO, class Self>
+    static void state_fields(IO& io, Self& self, std::size_t real_count, std::size_t node_count);
+    void check_restored(StateReader& in, std::size_t real_count, std::size_t node_count) const;
+
     std::vector<std::uint8_t> continues_;                // continuing_flags()
     std::array<std::vector<double>, 3> saved_force_;     // save_forces(), per ghost
     std::vector<GhostPlane> planes_;

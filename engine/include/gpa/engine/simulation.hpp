@@ -243,6 +243,9 @@ public:
     // identifies the scene to the caller, e.g. a hash of its file) and `user_data` (anything the
     // caller wants back).
     void save_checkpoint(std::ostream& out, std::string_view scene_fingerprint, std::string_view user_data = {}) const;
+    // Where each field of save_checkpoint's output begins (bytes from the file's start; each
+    // section's tag is one), so that two checkpoints can be compared field by field.
+    std::vector<std::uint64_t> checkpoint_field_starts(std::string_view scene_fingerprint, std::string_view user_data = {}) const;
     // Every scene can be checkpointed, element bodies included (format 5); kept for programs
     // written against earlier versions, where element scenes could not.
     bool can_checkpoint() const;

@@ -42,46 +42,85 @@ class StateWriter {
 public:
     explicit StateWriter(std::ostream& out) : out_(out) {}
 
+    // Where each value, array, text, tag and field begins (bytes from the first one written), for
+    // a test that compares two checkpoints field by field; not recorded unless asked for.
+    void record_field_starts(std::vector<std::uint64_t>* starts) { starts_ = starts; }
+
     void bytes(const void* data, std::size_t count) {
         checksum_.add(data, count);
         out_.write(static_cast<const char*>(data), static_cast<std::streamsize>(count));
+        written_ += count;
     }
     template <class T>
     void value(const T& v) {
         static_assert(std::is_trivially_copyable_v<T>);
+        const FieldStart start(*this);
         bytes(&v, sizeof v);
     }
     template <class T>
     void array(const std::vector<T>& v) {
         static_assert(std::is_trivially_copyable_v<T>);
+        const FieldStart start(*this);
         value<std::uint64_t>(v.size());
         bytes(v.data(), v.size() * sizeof(T));
     }
     void text(std::string_view s) {
+        const FieldStart start(*this);
         value<std::uint64_t>(s.size());
         bytes(s.data(), s.size());
     }
     // A section mark: four letters.
-    void tag(std::string_view name) { bytes(name.data(), 4); }
+    void tag(std::string_view name) {
+        const FieldStart start(*this);
+        bytes(name.data(), 4);
+    }
 
-    // One field of a list that StateReader reads back with the same calls (a part's fields listed
-    // once, for both directions: template <class IO> void fields(IO& io, Part& p) { io.field(p.x); }).
+    // The calls below are StateReader's too, so that a part lists its state once for both
+    // directions: template <class IO, class Self> void fields(IO& io, Self& s) { io.field(s.x); },
+    // Self const when writing. `reading` tells a list's read-only checks apart (if constexpr).
+    static constexpr bool reading = false;
     void field(double v) { value(v); }
     void field(std::size_t v) { value<std::uint64_t>(v); }
+    void field(std::uint32_t v) { value(v); }
+    void field(std::int32_t v) { value(v); }
     void field(bool v) { value<std::uint8_t>(v ? 1 : 0); }
     void field(const std::string& s) { text(s); }
+    // An array, its length first (StateReader: at most `max_count` elements).
+    template <class T>
+    void field(const std::vector<T>& v, std::uint64_t /*max_count*/ = UINT64_MAX) {
+        array(v);
+    }
     // A sequence's length, ahead of its elements (StateReader::sequence checks it).
     template <class Vector>
     void sequence(const Vector& v, std::size_t /*expected*/, std::string_view /*what*/) {
         value<std::uint64_t>(v.size());
     }
+    // A count that the reader must find equal to its own (StateReader::expect).
+    void expect(std::size_t count, std::string_view /*what*/) { value<std::uint64_t>(count); }
 
     std::uint64_t checksum() const { return checksum_.value(); }
     bool good() const { return static_cast<bool>(out_); }
 
 private:
+    // Records the start of the outermost call only (an array's length is not a field of its own).
+    class FieldStart {
+    public:
+        explicit FieldStart(StateWriter& w) : w_(w) {
+            if (w_.depth_++ == 0 && w_.starts_) w_.starts_->push_back(w_.written_);
+        }
+        ~FieldStart() { --w_.depth_; }
+        FieldStart(const FieldStart&) = delete;
+        FieldStart& operator=(const FieldStart&) = delete;
+
+    private:
+        StateWriter& w_;
+    };
+
     std::ostream& out_;
     Checksum checksum_;
+    std::uint64_t written_ = 0;
+    std::vector<std::uint64_t>* starts_ = nullptr;
+    int depth_ = 0;
 };
 
 class StateReader {
@@ -135,10 +174,22 @@ public:
     }
 
     // The fields StateWriter::field wrote, read into place.
+    static constexpr bool reading = true;
     void field(double& v) { v = value<double>(); }
     void field(std::size_t& v) { v = static_cast<std::size_t>(value<std::uint64_t>()); }
+    void field(std::uint32_t& v) { v = value<std::uint32_t>(); }
+    void field(std::int32_t& v) { v = value<std::int32_t>(); }
     void field(bool& v) { v = value<std::uint8_t>() != 0; }
     void field(std::string& s) { s = text(); }
+    template <class T>
+    void field(std::vector<T>& v, std::uint64_t max_count = UINT64_MAX) {
+        array(v, max_count);
+    }
+    // The count StateWriter::expect wrote: it must be `count`, else the checkpoint is refused
+    // naming `what` ("its planes are not the scene's").
+    void expect(std::size_t count, std::string_view what) {
+        if (value<std::uint64_t>() != count) fail(std::string(what));
+    }
     // A sequence's length: it must be `expected` (the scene's count), else the checkpoint is
     // refused naming `what` ("its planes are not the scene's"); the sequence is resized to it.
     template <class Vector>
@@ -164,5 +215,12 @@ private:
 struct CompressedRows;
 void write_rows(StateWriter& out, const CompressedRows& rows);
 void read_rows(StateReader& in, CompressedRows& rows, std::size_t rows_expected, std::size_t index_limit);
+// Both directions, for a part's one list of fields.
+inline void rows_field(StateWriter& out, const CompressedRows& rows, std::size_t /*rows_expected*/, std::size_t /*index_limit*/) {
+    write_rows(out, rows);
+}
+inline void rows_field(StateReader& in, CompressedRows& rows, std::size_t rows_expected, std::size_t index_limit) {
+    read_rows(in, rows, rows_expected, index_limit);
+}
 
 }  // namespace gpa
