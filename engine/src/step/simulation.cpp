@@ -139,7 +139,7 @@ struct Simulation::Impl {
 
 template <class G>
 void Simulation::Impl::setup() {
-    validate_scene(scene);
+    // The scene was validated by the constructor, before its sizes were checked (once).
     influence.emplace(scene.solver.influence_distance);
     // Planes with ghosts: the axis of an axisymmetric scene first, then the scene's planes.
     std::vector<GhostPlane> planes;
