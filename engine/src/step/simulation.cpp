@@ -41,6 +41,7 @@
 #include "step/regions.hpp"
 #include "step/rigid_planes.hpp"
 #include "step/run_control.hpp"
+#include "step/stable_step.hpp"
 #include "step/switching.hpp"
 #include "reduce_grain.hpp"
 
@@ -64,7 +65,7 @@ struct Simulation::Impl {
     Switching switching_part;        // connectivity modes and the switching phase (step/switching.hpp)
     Measures measures;               // sums, extents, local fields, half-step energies (step/measures.hpp)
     SmoothingScratch smoothing_scratch;
-    std::vector<double> largest_bond_q;  // per centre, the largest Q_ij of its pairs (for the time step)
+    StableStep stable_step;          // the stable time step and its bond-viscous pressures (step/stable_step.hpp)
     bool failed = false;                 // a phase threw: the state is half-updated
     std::unique_ptr<PhaseGraph> graph;
     bool particles = true;                  // the scene has particle bodies (real > 0)
@@ -94,6 +95,7 @@ struct Simulation::Impl {
           neighbour_lists(scene.solver),
           contact(scene),
           switching_part(scene),
+          stable_step(scene),
           regions(scene.prescribed_velocities),
           ledger(scene.solver),
           run_control(scene, std::move(memory)) {}
@@ -321,68 +323,8 @@ void Simulation::Impl::refresh_ghosts_and_plan() {
 }
 
 void Simulation::Impl::time_step() {
-    // Spec section 11, dt = C_cfl min_i h_i / (c_i + sqrt(Q_i / rho_i) + w_i), w_i the largest speed
-    // at which a closed pair across an interface or crack closes on node i (separation.hpp; 0 in a
-    // scene of one body without failure), with h_i the node's stable
-    // length c / omega (kernels.hpp) in place of its smallest h_ij: h_ij ignores neighbours much
-    // closer than h and neighbourhoods that have thinned out along one axis, and runs with it were
-    // found unstable at any C_cfl above 0.1 once the impact face of a Taylor bar had spread.
-    // Besides, no step may change a node's volume by more than solver.max_volume_change:
-    // dt <= max_volume_change / |eps_v_dot_i| with the node's last rate, for compression, and for
-    // expansion while its pressure is positive (a failed node expanding at zero pressure, debris,
-    // does no work). The stable length sees the in-plane neighbours only; a failed node driven
-    // towards the axis of an axisymmetric body (hoop rate u / x) or crushed between fragments
-    // closing faster than sound was compressed 29 % in one step, and the pressure it then had a
-    // step late gave back more work than its compression had booked: the kinetic energy of the
-    // all-variable hypervelocity impact at 0.2 mm quadrupled in 20 steps, energy balance intact,
-    // with the internal energy going negative.
-    const double* closing_speed = contact.closing_speed();
-    const double volume_limit = scene.solver.max_volume_change > 0.0 ? scene.solver.max_volume_change / scene.solver.cfl : 0.0;
-    const double limit = tbb::parallel_reduce(
-        tbb::blocked_range<std::size_t>(0, real, costly_node_grain), std::numeric_limits<double>::infinity(),
-        [&](const tbb::blocked_range<std::size_t>& r, double best) {
-            for (std::size_t i = r.begin(); i != r.end(); ++i) {
-                const double q = std::max(nodes.viscous_pressure[i], largest_bond_q.empty() ? 0.0 : largest_bond_q[i]);
-                double local = stable_time_step(nodes.stable_length[i], nodes.sound_speed[i], q, nodes.mass[i] / nodes.volume[i],
-                                                closing_speed ? closing_speed[i] : 0.0);
-                const double rate = nodes.volumetric_strain_rate[i];
-                if (volume_limit > 0.0 && (rate < 0.0 || nodes.pressure[i] > 0.0) && std::abs(rate) > 0.0) {
-                    local = std::min(local, volume_limit / std::abs(rate));
-                }
-                // NaN would drop out of a minimum: make it win, and report it below.
-                best = std::isnan(local) ? local : std::min(best, local);
-                if (std::isnan(best)) return best;
-            }
-            return best;
-        },
-        [](double x, double y) { return std::isnan(x) || std::isnan(y) ? std::nan("") : std::min(x, y); });
     const double element_limit = elements ? elements->stable_time_step() : std::numeric_limits<double>::infinity();
-    if (std::isnan(limit)) {
-        for (std::size_t i = 0; i < real; ++i) {
-            const double local = nodes.stable_length[i] / nodes.sound_speed[i];
-            if (std::isnan(local)) {
-                throw NumericalError(fmt::format("{} at t = {:.6g} s: its stable time step is not "
-                                                 "a number (stable length {}, sound speed {}, volume {})",
-                                                 describe_node(nodes, i), time, nodes.stable_length[i], nodes.sound_speed[i], nodes.volume[i]),
-                                     i, "stable time step");
-            }
-        }
-        throw NumericalError(fmt::format("the stable time step is not a number at t = {} s", time));
-    }
-    double dt = scene.solver.cfl * std::min(limit, element_limit);
-    if (dt_half > 0.0) dt = std::min(dt, scene.solver.time_step_growth * dt_half);
-    dt = std::min(dt, scene.solver.max_time_step);
-    // Land on the end time instead of stepping past it (unless only a sliver would remain).
-    const double end = scene.stop.end_time;
-    if (end > 0.0 && time < end) {
-        const double left = end - time;
-        if (dt > left) dt = left;
-        else if (dt > 0.5 * left) dt = 0.5 * left;
-    }
-    if (!(dt > 0.0) || !std::isfinite(dt)) {
-        throw NumericalError(fmt::format("the stable time step is {} s at t = {} s (a node has no size or no sound speed)", dt, time));
-    }
-    dt_next = dt;
+    dt_next = stable_step.next(nodes, real, contact.closing_speed(), element_limit, time, dt_half);
 }
 
 template <class G>
@@ -397,8 +339,7 @@ void Simulation::Impl::forces() {
     if (with_bond) {
         f.viscous_pressure = nullptr;
         f.bond_viscous_power = ledger.bond_power(nodes.size());
-        largest_bond_q.assign(nodes.size(), 0.0);
-        f.largest_bond_viscosity = largest_bond_q.data();
+        f.largest_bond_viscosity = stable_step.bond_viscosity(nodes.size());
     }
     compute_forces<G>(lists(), plan(), scene.solver.weight, with_bond ? &bond : nullptr, f, nodes.size());
     if (ledger.hourglass()) {
@@ -789,7 +730,7 @@ MemoryUse Simulation::memory_use() const {
     im.ledger.memory_use(out);
     im.external.memory_use(out);
     im.switching_part.memory_use(out);
-    add_memory(out, "forces: largest bond viscosity", allocated_bytes(im.largest_bond_q));
+    im.stable_step.memory_use(out);
     const auto& s = im.smoothing_scratch;
     add_memory(out, "smoothing: scratch", allocated_bytes(s.centre_change) + allocated_bytes(s.share) + allocated_bytes(s.total_change));
     std::size_t groups = 0;
@@ -912,7 +853,7 @@ std::vector<double> state_sections(IO& io, Impl& s) {
         s.neighbour_lists.write_state(io, s.dim());
     }
     io.tag("TIME");
-    io.field(s.largest_bond_q);
+    part_state(io, s.stable_step);
     clock_fields(io, s);
     std::vector<double> body_kinetic;
     if constexpr (!reading) {
