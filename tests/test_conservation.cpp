@@ -193,10 +193,12 @@ void check_energy(const ForceCase& s, const BondViscosityParameters* bond, bool 
                 }
                 al_dv = (N * l).dot(dv);
                 const double h = influence * 0.5 * (n.diameter[i] + n.diameter[j]);
-                // Lattice pairs (fixed centre and neighbour) weigh R(min(r/h, 1.8)) (spec section 2,
-                // lattice weights), all others R(r/h).
+                // Lattice pairs (fixed centre and neighbour) weigh R(min(r/h, v_f)) (spec section 2,
+                // lattice weights), all others R(r/h); v_f is 1.8, or the v of the default stencil's
+                // farthest pair where that is larger: at a = 1.2 the lattice nodes within 2.4 d0
+                // reach sqrt(5) d0, v = 1.863.
                 const bool lattice = s.connectivity == Connectivity::Fixed && n.connectivity[j] == Connectivity::Fixed;
-                const double q = lattice ? std::min(r / h, 1.8) : r / h;
+                const double q = lattice ? std::min(r / h, std::max(1.8, std::sqrt(5.0) / influence)) : r / h;
                 double R = 0.0;
                 if (s.weight == WeightKind::Gpa) {
                     R = 1.0 - q / 2.0;

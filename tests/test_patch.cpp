@@ -24,12 +24,16 @@ struct PatchCase {
     WeightKind weight;
     double influence_distance;
     int lattice_neighbours;  // fixed connectivity only
+    // Fixed connectivity only: beyond the stencil, every lattice node within this many d0 (the
+    // default stencil of a body with a > 1 takes 2 a: bodies.cpp, LatticeBlock::stencil_reach).
+    double stencil_reach = 0.0;
 };
 
 std::string case_name(const PatchCase& c) {
-    return fmt::format("{} {} {} a={} n={}", name_of(c.geometry),
+    return fmt::format("{} {} {} a={} n={}{}", name_of(c.geometry),
                        c.connectivity == Connectivity::Fixed ? "fixed" : "variable",
-                       c.weight == WeightKind::Gpa ? "GPA" : "SPH-NSF", c.influence_distance, c.lattice_neighbours);
+                       c.weight == WeightKind::Gpa ? "GPA" : "SPH-NSF", c.influence_distance, c.lattice_neighbours,
+                       c.stencil_reach > 0.0 ? fmt::format(" reach={}", c.stencil_reach) : std::string());
 }
 
 void PrintTo(const PatchCase& c, std::ostream* os) { *os << case_name(c); }
@@ -41,6 +45,9 @@ std::vector<PatchCase> all_cases() {
         for (int n : three ? std::vector<int>{6, 18, 26} : std::vector<int>{4, 8}) {
             cases.push_back({g, Connectivity::Fixed, WeightKind::Gpa, 1.0, n});
         }
+        // The default stencil of the Taylor scenes' fixed nodes: SPH-NSF at a = 1.3, the box and
+        // every lattice node within 2 a d0 (20 neighbours in 2D, 80 in 3D).
+        cases.push_back({g, Connectivity::Fixed, WeightKind::SphNsf, 1.3, three ? 26 : 8, 2.6});
         for (double a : {0.8, 1.0, 1.5}) {
             cases.push_back({g, Connectivity::Variable, WeightKind::Gpa, a, 0});
             cases.push_back({g, Connectivity::Variable, WeightKind::SphNsf, a, 0});
@@ -58,6 +65,7 @@ LatticeOptions options_for(const PatchCase& c) {
     o.x_origin = c.geometry == GeometryKind::PlaneStrain ? -1.5 : 0.0;
     o.connectivity = c.connectivity;
     o.lattice_neighbours = c.lattice_neighbours;
+    o.stencil_reach = c.stencil_reach;
     return o;
 }
 
@@ -106,6 +114,19 @@ void run_regular_lattice_patch(const PatchCase& c) {
             }
         }
         ASSERT_GT(checked, 8u) << case_name(c) << ": too few interior nodes to test";
+    }
+    if (c.stencil_reach > 0.0) {
+        // The stencil is the one meant: an interior fixed node pairs with the lattice nodes within
+        // 2.6 d0, 20 in 2D (4 at 1, 4 at sqrt 2, 4 at 2, 8 at sqrt 5 spacings) and 80 in 3D.
+        const auto lists = find_neighbours(nodes, c.influence_distance, nodes.size());
+        const std::size_t expected = D == 3 ? 80 : 20;
+        std::size_t interior = 0;
+        for (std::size_t i = 0; i < nodes.size(); ++i) {
+            if (testing::distance_to_boundary(nodes, o, i) <= 2.0 * c.influence_distance * o.spacing) continue;
+            ++interior;
+            ASSERT_EQ(lists.row_size(i), expected) << case_name(c) << " node " << i;
+        }
+        ASSERT_GT(interior, 8u);
     }
     if constexpr (G::axisymmetric) {
         // Eq. 12 with the hoop rate: u = g_xx x is physical at the axis, so u/x = g_xx exactly and

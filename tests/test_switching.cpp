@@ -104,6 +104,92 @@ TEST(MixedConnectivity, AUniformStressGivesNoForceAcrossTheFrontWithTheSphNsfWei
     expect_no_force_across_the_front(WeightKind::SphNsf, 1.3, 2.0 * 1.3, 4.1, 36, 12);
 }
 
+// The same front in 3D and in an axisymmetric body, on the Taylor scenes' stencil (SPH-NSF at
+// a = 1.3, fixed nodes keeping every lattice node within 2.6 spacings): the lower half of a lattice
+// fixed, the upper half variable, under a uniform stress. In 3D any uniform stress; in the
+// axisymmetric body a hydrostatic one (sigma_rr = sigma_tt = sigma_zz), whose divergence vanishes
+// in cylindrical coordinates too (a uniform deviator with s_rr != s_tt would not be in equilibrium:
+// (s_rr - s_tt) / r). Every node with a complete neighbourhood, the axis's mirror nodes included,
+// must feel no net force. The 3D case failed before a lattice pair's weight followed its length
+// as far as the stencil reaches (weights.hpp, lattice_weight_reach_for): held at R(1.8), the
+// stencil's outer shell (sqrt(6) d0, v = 1.884) weighed 2.8 times what the same pair weighs across
+// the front, and the nodes next to it took 1.4 % of P d^2.
+template <class G>
+double largest_front_force(double margin, std::size_t& checked, std::size_t& at_front) {
+    constexpr int D = G::dim;
+    constexpr double a = 1.3;
+    testing::LatticeOptions o;
+    o.geometry = G::kind;
+    o.cells = D == 3 ? 12 : cells;
+    o.spacing = lattice_spacing;
+    o.connectivity = Connectivity::Fixed;
+    o.density = 7800.0;
+    o.stencil_reach = 2.0 * a;
+    NodeStore nodes = testing::make_lattice(o);
+    const double front = 0.5 * o.cells * lattice_spacing;
+    for (std::size_t i = 0; i < nodes.size(); ++i) {
+        if (nodes.position[D - 1][i] > front) nodes.connectivity[i] = Connectivity::Variable;
+    }
+    const auto lists = find_neighbours(nodes, a, nodes.size());
+    const int components = stress_components(D);
+    for (std::size_t i = 0; i < nodes.size(); ++i) {
+        for (int c = 0; c < components; ++c) nodes.deviatoric_stress[c][i] = 0.0;
+        if constexpr (D == 3) {
+            const double s[6] = {-4e7, 6e7, -2e7, 3e7, -1e7, 2e7};  // xx yy zz yz xz xy, trace 0
+            for (int c = 0; c < 6; ++c) nodes.deviatoric_stress[c][i] = s[c];
+        }
+        nodes.pressure[i] = 5e8;
+    }
+    compute_velocity_gradient<G>(lists, WeightKind::SphNsf, gradient_fields<D>(nodes, a));
+    PositionView x;
+    x.dim = D;
+    for (int c = 0; c < D; ++c) x.component[c] = nodes.position[c].data();
+    auto f = force_fields<D>(nodes, a);
+    f.viscous_pressure = nullptr;
+    f.hoop_count = nodes.size();
+    compute_forces<G>(lists, make_slab_plan(lists, x), WeightKind::SphNsf, nullptr, f, nodes.size());
+    double worst = 0.0;
+    checked = at_front = 0;
+    for (std::size_t i = 0; i < nodes.size(); ++i) {
+        if (testing::distance_to_boundary(nodes, o, i) < margin * lattice_spacing) continue;
+        ++checked;
+        at_front += std::abs(nodes.position[D - 1][i] - front) < 1.6 * lattice_spacing;
+        double scale = 5e8 * lattice_spacing * lattice_spacing;  // 3D: the pressure on a node's face
+        if constexpr (G::axisymmetric) scale = 5e8 * lattice_spacing * 2.0 * 3.141592653589793 * nodes.position[0][i];
+        for (int c = 0; c < D; ++c) worst = std::max(worst, std::abs(nodes.force[c][i]) / scale);
+    }
+    return worst;
+}
+
+TEST(MixedConnectivity, ALatticePairFollowsItsLengthAsFarAsTheStencilReaches) {
+    // The floor of lattice weights (weights.hpp): 1.8 where the default stencil lies within it,
+    // else the v of its farthest pair; never at or beyond the support's 2.
+    EXPECT_EQ(lattice_weight_reach_for(1.0, 2), lattice_weight_reach);  // box of 8: sqrt(2) = 1.41
+    EXPECT_EQ(lattice_weight_reach_for(1.0, 3), lattice_weight_reach);  // box of 26: sqrt(3) = 1.73
+    EXPECT_EQ(lattice_weight_reach_for(1.3, 2), lattice_weight_reach);  // sqrt(5) / 1.3 = 1.72
+    EXPECT_DOUBLE_EQ(lattice_weight_reach_for(1.3, 3), std::sqrt(6.0) / 1.3);  // 1.884
+    EXPECT_DOUBLE_EQ(lattice_weight_reach_for(1.2, 2), std::sqrt(5.0) / 1.2);  // 1.863 (2.4 d0 holds sqrt(5))
+    EXPECT_EQ(lattice_weight_reach_for(0.8, 3), lattice_weight_reach);  // the box's corner, 2.17, lies beyond the support
+    // The kernels read it from the fields of the scene's a and dimension.
+    NodeStore three_d(GeometryKind::ThreeD);
+    EXPECT_DOUBLE_EQ(pair_fields<3>(three_d, 1.3).lattice_reach, std::sqrt(6.0) / 1.3);
+}
+
+TEST(MixedConnectivity, AUniformStressGivesNoForceAcrossTheFrontInThreeDAndAboutAnAxis) {
+    std::size_t checked = 0, at_front = 0;
+    const double three_d = largest_front_force<ThreeD>(4.1, checked, at_front);
+    std::printf("[ measured ] 3D front, a = 1.3: largest net force %.3g of P d^2 over %zu nodes (%zu at the front)\n", three_d,
+                checked, at_front);
+    EXPECT_GE(checked, 27u);
+    EXPECT_GE(at_front, 9u);
+    EXPECT_LT(three_d, 1e-12);
+    const double axisymmetric = largest_front_force<Axisymmetric>(4.1, checked, at_front);
+    std::printf("[ measured ] axisymmetric front, a = 1.3: largest net force %.3g of P d 2 pi r over %zu nodes (%zu at the front)\n",
+                axisymmetric, checked, at_front);
+    EXPECT_GE(checked, 20u);
+    EXPECT_LT(axisymmetric, 1e-12);
+}
+
 // A pair is in both rows or in neither (within one body): lattice pairs link two fixed nodes,
 // every other pair is found by search with the same rule r < 2 h_ij from both ends.
 TEST(MixedConnectivity, PairsAreSymmetricAndLatticePairsLinkFixedNodesOnly) {

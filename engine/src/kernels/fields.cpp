@@ -32,6 +32,7 @@ PairFields<D> pair_fields(const NodeStore& nodes, InfluenceDistance influence_di
     p.connectivity = nodes.connectivity.data();
     p.body = nodes.body.data();
     p.influence_distance = influence_distance.value();
+    p.lattice_reach = lattice_weight_reach_for(p.influence_distance, D);
     return p;
 }
 

@@ -28,6 +28,9 @@ struct PairFields {
     const Connectivity* connectivity = nullptr;
     const std::int32_t* body = nullptr;
     double influence_distance = 1.0;
+    // v at which a lattice pair's weight stops falling (weights.hpp, lattice_weight_reach_for;
+    // pair_fields sets it for the scene's influence distance and dimension).
+    double lattice_reach = lattice_weight_reach;
     // Sliding contact (spec section 2, "[spec] Sliding contact"; docs/contact.md): with
     // `sliding_contact`, a pair between two bodies, or (with failed_pairs_separate) one with a failed
     // node, carries velocity differences and forces along one direction only (sliding_normal). Such a
@@ -73,7 +76,7 @@ struct PairFields {
     }
 
     // Pair geometry of centre i and neighbour j. Every pair weighs R(r / h) (Eq. 1b or 62-65); a
-    // lattice pair R(min(r / h, lattice_weight_reach)), so that it is never lost however far its
+    // lattice pair R(min(r / h, lattice_reach)), so that it is never lost however far its
     // nodes move apart (spec section 2, "[spec] Lattice weights"; the paper's Eq. 1a has R = 1).
     // r = 0 (coincident nodes) is returned as is; the drivers report it.
     template <class VariableWeight>
@@ -85,7 +88,7 @@ struct PairFields {
         p.l = p.dx * p.inv_r;
         p.h = pair_smoothing_length(influence_distance, diameter[i], diameter[j]);
         const double v = p.r / p.h;
-        p.R = VariableWeight::value(lattice_pair(i, j) ? std::min(v, lattice_weight_reach) : v);
+        p.R = VariableWeight::value(lattice_pair(i, j) ? std::min(v, lattice_reach) : v);
         p.R_over_r2 = p.R * p.inv_r * p.inv_r;
         return p;
     }
@@ -154,8 +157,8 @@ struct PairFields {
         const Lanes inv_r = 1.0 / r;
         const Lanes h = pair_smoothing_length(influence_distance, Lanes{diameter[i], diameter[i]}, Lanes{diameter[j0], diameter[j1]});
         Lanes v = r / h;
-        if (lattice_pair(i, j0)) v[0] = std::min(v[0], lattice_weight_reach);
-        if (lattice_pair(i, j1)) v[1] = std::min(v[1], lattice_weight_reach);
+        if (lattice_pair(i, j0)) v[0] = std::min(v[0], lattice_reach);
+        if (lattice_pair(i, j1)) v[1] = std::min(v[1], lattice_reach);
         const Lanes R = VariableWeight::value(v);
         const Lanes R_over_r2 = R * inv_r * inv_r;
         for (int lane = 0; lane < 2; ++lane) {

@@ -2,11 +2,13 @@
 // Distance weights R_ij of the method (spec section 2 and 8). The normalisation by the geometry
 // factors alpha removes any constant factor of R, so only R's shape matters.
 
+#include <cmath>
+
 namespace gpa {
 
 // The distance weight of every pair (Eq. 1b or 62-65). Fixed-connectivity (lattice) pairs use the
-// same function, at v = r/h but never beyond lattice_weight_reach, so that a lattice pair keeps a
-// weight however far apart its nodes move (spec section 2, "[spec] Lattice weights"; the paper's
+// same function, at v = r/h but never beyond lattice_weight_reach_for (below), so that a lattice
+// pair keeps a weight however far apart its nodes move (spec section 2, "[spec] Lattice weights"; the paper's
 // Eq. 1a has R = 1).
 enum class WeightKind {
     Gpa,     // R = 1 - v/2 (Eq. 1b)
@@ -15,6 +17,35 @@ enum class WeightKind {
 
 // v at which a lattice pair's weight stops falling: R(1.8) = 0.1 for the GPA weight.
 inline constexpr double lattice_weight_reach = 1.8;
+
+// The v at which lattice pairs stop falling in a scene of influence distance `a` and dimension
+// `dim` (PairFields::lattice_reach): lattice_weight_reach, or, where the default stencil's
+// farthest pair on the undeformed lattice lies beyond it and still within the support (v < 2),
+// that pair's v: in 3D at a = 1.3 the stencil of every lattice node within 2 a d0 reaches
+// sqrt(6) d0, v = 1.884. Below that v every lattice pair of the undeformed lattice weighs what a
+// variable pair at its distance weighs, so that forces balance across a front between fixed and
+// variable nodes (docs/connectivity.md, "The front in 3D"); with the floor at 1.8 the stencil's
+// outer shell weighed R(1.8), 2.8 times R(1.884) of SPH-NSF, and a uniform pressure pushed the
+// nodes next to a front by 1.4 % of P d^2. The default stencil (bodies.cpp): the box of 8 / 26,
+// and beyond it, for a > 1, every lattice node closer than 2 a d0 (unit spacing d0 here).
+inline double lattice_weight_reach_for(double a, int dim) {
+    double farthest = 0.0;
+    const int box = a > 1.0 ? 3 : 1;
+    for (int i = -box; i <= box; ++i) {
+        for (int j = -box; j <= box; ++j) {
+            for (int k = (dim == 3 ? -box : 0); k <= (dim == 3 ? box : 0); ++k) {
+                const double r2 = static_cast<double>(i * i + j * j + k * k);
+                if (r2 == 0.0) continue;
+                const bool in_box = i * i <= 1 && j * j <= 1 && k * k <= 1;
+                const bool within_reach = a > 1.0 && r2 < 4.0 * a * a;
+                if (!in_box && !within_reach) continue;
+                const double v = std::sqrt(r2) / a;
+                if (v < 2.0 && v > farthest) farthest = v;
+            }
+        }
+    }
+    return farthest > lattice_weight_reach ? farthest : lattice_weight_reach;
+}
 
 // The weights below take a double, or two of them at once as a GCC vector (fields.hpp,
 // PairFields::two_pairs), for which the comparisons give masks and ?: picks lane by lane; each
