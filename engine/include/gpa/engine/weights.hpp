@@ -28,22 +28,22 @@ inline constexpr double lattice_weight_reach = 1.8;
 // outer shell weighed R(1.8), 2.8 times R(1.884) of SPH-NSF, and a uniform pressure pushed the
 // nodes next to a front by 1.4 % of P d^2. The default stencil (bodies.cpp): the box of 8 / 26,
 // and beyond it, for a > 1, every lattice node closer than 2 a d0 (unit spacing d0 here).
+// (Made for every phase's fields: integer offsets, one square root.)
 inline double lattice_weight_reach_for(double a, int dim) {
-    double farthest = 0.0;
-    const int box = a > 1.0 ? 3 : 1;
-    for (int i = -box; i <= box; ++i) {
-        for (int j = -box; j <= box; ++j) {
-            for (int k = (dim == 3 ? -box : 0); k <= (dim == 3 ? box : 0); ++k) {
-                const double r2 = static_cast<double>(i * i + j * j + k * k);
-                if (r2 == 0.0) continue;
-                const bool in_box = i * i <= 1 && j * j <= 1 && k * k <= 1;
-                const bool within_reach = a > 1.0 && r2 < 4.0 * a * a;
-                if (!in_box && !within_reach) continue;
-                const double v = std::sqrt(r2) / a;
-                if (v < 2.0 && v > farthest) farthest = v;
+    const double support2 = 4.0 * a * a;  // v < 2: r^2 < (2 a d0)^2
+    int farthest2 = 0;
+    const int box = a > 1.0 ? 3 : 1;  // 2 a <= 3 (a <= max_influence_distance)
+    for (int i = 0; i <= box; ++i) {
+        for (int j = 0; j <= box; ++j) {
+            for (int k = 0; k <= (dim == 3 ? box : 0); ++k) {
+                const int r2 = i * i + j * j + k * k;
+                const bool in_box = i <= 1 && j <= 1 && k <= 1;
+                const bool within_reach = a > 1.0 && r2 < support2;
+                if (r2 > farthest2 && (in_box || within_reach) && r2 < support2) farthest2 = r2;
             }
         }
     }
+    const double farthest = std::sqrt(static_cast<double>(farthest2)) / a;
     return farthest > lattice_weight_reach ? farthest : lattice_weight_reach;
 }
 
