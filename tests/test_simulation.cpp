@@ -5,6 +5,7 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <map>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -412,6 +413,43 @@ TEST(NeighbourSkin, OnlyTheRowsOfNodesThatMovedAreSearchedAgainAndTheListsStayTh
         }
         EXPECT_TRUE(testing::node_bytes(one) == testing::node_bytes(two));
     }
+}
+
+// A node that switches next to a quiet centre (a fixed centre whose candidates are its lattice row
+// alone) gives that centre a pair its row lacks. The switched node's row is searched alone and the
+// pair put into both rows (NeighbourLists::switched_near_quiet_rows, search_rows), not every row:
+// a bar struck by a fast body, whose face switches to variable connectivity while the rest of the
+// bar stays quiet, needs about the full searches of the same bar all-variable, which has no quiet
+// rows (a switch made every row stale until 2026-12-07: 7 full searches against 1). Every step's
+// lists are those of a full search (check_neighbour_lists), and the run is bit-identical on 1 and
+// 2 threads.
+TEST(NeighbourSkin, ASwitchNextToAQuietCentreSearchesTheSwitchedRowsAlone) {
+    std::map<ConnectivityMode, Totals> totals;
+    for (ConnectivityMode target : {ConnectivityMode::Variable, ConnectivityMode::Automatic}) {
+        const char* name = target == ConnectivityMode::Variable ? "variable" : "automatic";
+        SCOPED_TRACE(name);
+        Scene scene = testing::struck_by_a_fast_body(testing::armco_cylinder(12, 40e-6), target);
+        scene.solver.check_neighbour_lists = true;
+        Simulation one(scene, 1), two(scene, 2);
+        for (int k = 0; k < 120 && !one.finished(); ++k) {
+            ASSERT_NO_THROW(one.step()) << "step " << k;
+            ASSERT_NO_THROW(two.step()) << "step " << k;
+        }
+        EXPECT_TRUE(testing::node_bytes(one) == testing::node_bytes(two));
+        totals[target] = one.totals();
+        std::printf("[ measured ] %s target: %zu full searches, %zu searches of %zu rows, %zu variable nodes of %zu\n", name,
+                    one.totals().neighbour_searches, one.totals().row_searches, one.totals().rows_searched,
+                    one.totals().variable_nodes, one.totals().real_nodes);
+    }
+    const Totals& automatic = totals[ConnectivityMode::Automatic];
+    const Totals& variable = totals[ConnectivityMode::Variable];
+    ASSERT_GT(automatic.variable_nodes, 40u) << "the struck face must switch";  // the shot's nodes and the bar's face
+    ASSERT_LT(automatic.variable_nodes, automatic.real_nodes / 4) << "the rest of the bar must stay fixed";
+    // One more than all-variable: rows searched alone keep their old entries, and when the
+    // candidates have grown by a quarter since the last full search (the quiet rows grow from
+    // their lattice rows as their neighbours switch) a full search starts them afresh (choose_rows).
+    EXPECT_LE(automatic.neighbour_searches, variable.neighbour_searches + 1) << "a switch must not make every row stale";
+    EXPECT_GT(automatic.row_searches, variable.row_searches) << "the switched rows must have been searched alone";
 }
 
 TEST(NeighbourSkin, ARunDoesNotDependOnTheSkinBeyondRoundOff) {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <iterator>
 #include <limits>
 
 #include <fmt/format.h>
@@ -90,14 +91,18 @@ void NeighbourLists::place_ghosts(NodeStore& nodes, std::size_t real, GhostSet& 
     if (with_skin_ && !search_due_) {
         const double rounding = 1e-9 * searched_range_;
         const Staleness s = staleness(nodes, real, ghosts, influence_distance, rounding);
-        // A full search when the ghosts no longer cover the planes' reach, when a node has
-        // switched next to a quiet centre, or when a position or diameter is not finite (the
-        // phases after the search report it).
-        if (s.ghosts_short || !std::isfinite(s.largest_budget) || switched_near_quiet_rows(nodes, real, ghosts)) {
+        // A full search when the ghosts no longer cover the planes' reach, or when a position or
+        // diameter is not finite (the phases after the search report it).
+        if (s.ghosts_short || !std::isfinite(s.largest_budget)) {
             search_due_ = true;
-        } else if (!s.common_bound_holds && !(3.0 * s.largest_budget + rounding < skin_)) {
-            // Neither bound holds (the header): search the rows that have moved, or all.
-            choose_rows(nodes, real, influence_distance);
+        } else {
+            if (!s.common_bound_holds && !(3.0 * s.largest_budget + rounding < skin_)) {
+                // Neither bound holds (the header): search the rows that have moved, or all.
+                choose_rows(nodes, real, influence_distance);
+            }
+            // The rows of nodes that have switched next to a quiet centre (or were quiet
+            // themselves) join them: searched, each of their pairs goes into both rows.
+            if (!search_due_) add_rows_due(switched_near_quiet_rows(nodes, real, ghosts), real);
         }
     }
     if (ghosts.empty()) return;
@@ -225,33 +230,59 @@ void NeighbourLists::choose_rows(const NodeStore& nodes, std::size_t real, Influ
     for (std::size_t i = 0; i < real; ++i) {
         if (!(row_budget(nodes, i, a) <= limit)) rows_due_.push_back(static_cast<NodeIndex>(i));
     }
+    full_search_if_cheaper(real);
+}
+
+void NeighbourLists::full_search_if_cheaper(std::size_t real) {
     if (rows_due_.size() > real / 8 || candidates_.entries() > full_search_entries_ + full_search_entries_ / 4) {
         rows_due_.clear();
         search_due_ = true;
     }
 }
 
-bool NeighbourLists::switched_near_quiet_rows(const NodeStore& nodes, std::size_t real, const GhostSet& ghosts) const {
+void NeighbourLists::add_rows_due(const std::vector<NodeIndex>& rows, std::size_t real) {
+    if (rows.empty()) return;
+    // Both ascending: the union, ascending (search_rows takes the rows due in this order).
+    std::vector<NodeIndex> merged;
+    merged.reserve(rows_due_.size() + rows.size());
+    std::set_union(rows_due_.begin(), rows_due_.end(), rows.begin(), rows.end(), std::back_inserter(merged));
+    rows_due_.swap(merged);
+    full_search_if_cheaper(real);
+}
+
+std::vector<NodeIndex> NeighbourLists::switched_near_quiet_rows(const NodeStore& nodes, std::size_t real,
+                                                                const GhostSet& ghosts) const {
     // A quiet row lacks the fixed nodes of its body that are not its lattice neighbours; they
-    // become pairs only when one of the two switches. A node that switched since the search and
-    // was itself quiet lacks them all; one that was not holds every node within its reach in its
-    // candidates, so the quiet centres within its reach are in its row (a ghost entry names its
-    // source, whose row has the mirror image of the pair).
-    if (!any_quiet_) return false;
-    return tbb::parallel_reduce(
-        tbb::blocked_range<std::size_t>(0, real, costly_node_grain), false,
-        [&](const tbb::blocked_range<std::size_t>& r, bool found) {
-            for (std::size_t i = r.begin(); i != r.end() && !found; ++i) {
+    // become pairs only when one of the two switches. A node that switched since its row was
+    // searched and was itself quiet lacks them all; one that was not holds every node within its
+    // reach in its candidates, so the quiet centres within its reach are in its row (a ghost entry
+    // names its source, whose row has the mirror image of the pair), and they lack it. A search of
+    // the switched node's row finds every node within its reach and puts each pair into both rows
+    // (search_rows): the quiet rows gain the pairs the switch made, and nothing else changed for
+    // them (their other fixed nodes are still no pairs of theirs). So those rows, ascending.
+    using Rows = std::vector<NodeIndex>;
+    if (!any_quiet_) return {};
+    Rows rows = tbb::parallel_reduce(
+        tbb::blocked_range<std::size_t>(0, real, costly_node_grain), Rows{},
+        [&](const tbb::blocked_range<std::size_t>& r, Rows found) {
+            for (std::size_t i = r.begin(); i != r.end(); ++i) {
                 if (!searched_fixed_[i] || nodes.connectivity[i] == Connectivity::Fixed) continue;
-                if (quiet_[i]) return true;
+                bool near = quiet_[i] != 0;
                 for (NodeIndex j : candidates_.row(i)) {
+                    if (near) break;
                     const std::size_t centre = j < real ? j : ghosts.source(j - real);
-                    if (quiet_[centre]) return true;
+                    near = quiet_[centre] != 0;
                 }
+                if (near) found.push_back(static_cast<NodeIndex>(i));
             }
             return found;
         },
-        [](bool x, bool y) { return x || y; });
+        [](Rows x, const Rows& y) {
+            x.insert(x.end(), y.begin(), y.end());
+            return x;
+        });
+    std::sort(rows.begin(), rows.end());  // (the join keeps the ranges' order; sorted all the same)
+    return rows;
 }
 
 void NeighbourLists::check_against_search(const NodeStore& nodes, std::size_t real, const GhostSet& ghosts,
@@ -458,7 +489,9 @@ void NeighbourLists::update(NodeStore& nodes, std::size_t real, GhostSet& ghosts
             search_rows(nodes, real, ghosts, influence_distance, any_automatic);
         }
         // The quiet rows' lattice pairs are whole until a node near one of them switches, which
-        // place_ghosts turns into a search before this cut (switched_near_quiet_rows).
+        // place_ghosts turns into a search of the switched node's row before this cut
+        // (switched_near_quiet_rows); the quiet row, then longer than its lattice entries, is cut
+        // entry by entry.
         LatticeRowsKept kept_rows;
         kept_rows.switching = any_automatic;
         kept_rows.quiet = quiet_.data();

@@ -128,7 +128,13 @@ private:
     void search_rows(NodeStore& nodes, std::size_t real, GhostSet& ghosts, InfluenceDistance influence_distance, bool any_automatic);
     void plan_with_ghost_rows(const NodeStore& nodes, GhostSet& ghosts, std::size_t real);
     void place_ghosts_for_search(NodeStore& nodes, std::size_t real, GhostSet& ghosts, double a, double range);
-    bool switched_near_quiet_rows(const NodeStore& nodes, std::size_t real, const GhostSet& ghosts) const;
+    // The nodes that have switched since their rows were searched and were quiet, or have a quiet
+    // centre within their reach: their rows are due (the quiet rows lack their pairs).
+    std::vector<NodeIndex> switched_near_quiet_rows(const NodeStore& nodes, std::size_t real, const GhostSet& ghosts) const;
+    // `rows` (ascending) join the rows due; then, as choose_rows does, a full search instead
+    // where the rows due are many or the candidates have grown by a quarter.
+    void add_rows_due(const std::vector<NodeIndex>& rows, std::size_t real);
+    void full_search_if_cheaper(std::size_t real);
     void search_candidates(NodeStore& nodes, std::size_t real, GhostSet& ghosts, InfluenceDistance influence_distance,
                            bool any_automatic);
     void check_against_search(const NodeStore& nodes, std::size_t real, const GhostSet& ghosts, InfluenceDistance influence_distance,
@@ -148,7 +154,7 @@ private:
     std::vector<std::uint32_t> lattice_entries_;  // per row: how many leading candidates are lattice neighbours
     // Per row: the centre was quiet at the last search (NeighbourScratch::quiet), and whether it
     // was fixed then. A node that has switched since, with a quiet centre within its reach (or
-    // quiet itself), makes the candidates stale.
+    // quiet itself), makes its row due (switched_near_quiet_rows).
     std::vector<std::uint8_t> quiet_, searched_fixed_;
     bool any_quiet_ = false;
     std::vector<std::uint64_t> keep_scratch_;  // filter_candidates' kept entries, as bits
