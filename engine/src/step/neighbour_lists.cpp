@@ -259,7 +259,14 @@ std::vector<NodeIndex> NeighbourLists::switched_near_quiet_rows(const NodeStore&
     // names its source, whose row has the mirror image of the pair), and they lack it. A search of
     // the switched node's row finds every node within its reach and puts each pair into both rows
     // (search_rows): the quiet rows gain the pairs the switch made, and nothing else changed for
-    // them (their other fixed nodes are still no pairs of theirs). So those rows, ascending.
+    // them (their other fixed nodes are still no pairs of theirs). The quiet centres in its row
+    // are searched too: a quiet row is kept whole by the cut (filter_candidates), and one whose
+    // lattice neighbour switched would keep that pair however far it stretched (its row gains
+    // nothing, the pair is there already); searched, such a row holds every node within its reach
+    // and is no longer quiet. (A quiet centre farther than the switched node's lattice neighbours
+    // is not in the row of a switched node that was quiet itself: it gains the new pair at the end
+    // of its row, which the cut then takes entry by entry, and stays quiet, still lacking the
+    // rest.) So those rows, ascending, each once.
     using Rows = std::vector<NodeIndex>;
     if (!any_quiet_) return {};
     Rows rows = tbb::parallel_reduce(
@@ -267,13 +274,12 @@ std::vector<NodeIndex> NeighbourLists::switched_near_quiet_rows(const NodeStore&
         [&](const tbb::blocked_range<std::size_t>& r, Rows found) {
             for (std::size_t i = r.begin(); i != r.end(); ++i) {
                 if (!searched_fixed_[i] || nodes.connectivity[i] == Connectivity::Fixed) continue;
-                bool near = quiet_[i] != 0;
+                const std::size_t before = found.size();
                 for (NodeIndex j : candidates_.row(i)) {
-                    if (near) break;
                     const std::size_t centre = j < real ? j : ghosts.source(j - real);
-                    near = quiet_[centre] != 0;
+                    if (quiet_[centre]) found.push_back(static_cast<NodeIndex>(centre));
                 }
-                if (near) found.push_back(static_cast<NodeIndex>(i));
+                if (quiet_[i] || found.size() > before) found.push_back(static_cast<NodeIndex>(i));
             }
             return found;
         },
@@ -281,7 +287,8 @@ std::vector<NodeIndex> NeighbourLists::switched_near_quiet_rows(const NodeStore&
             x.insert(x.end(), y.begin(), y.end());
             return x;
         });
-    std::sort(rows.begin(), rows.end());  // (the join keeps the ranges' order; sorted all the same)
+    std::sort(rows.begin(), rows.end());
+    rows.erase(std::unique(rows.begin(), rows.end()), rows.end());
     return rows;
 }
 

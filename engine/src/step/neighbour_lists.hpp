@@ -129,7 +129,8 @@ private:
     void plan_with_ghost_rows(const NodeStore& nodes, GhostSet& ghosts, std::size_t real);
     void place_ghosts_for_search(NodeStore& nodes, std::size_t real, GhostSet& ghosts, double a, double range);
     // The nodes that have switched since their rows were searched and were quiet, or have a quiet
-    // centre within their reach: their rows are due (the quiet rows lack their pairs).
+    // centre within their reach, and those quiet centres: their rows are due (the quiet rows lack
+    // the switched nodes' pairs, and are kept whole by the cut while quiet).
     std::vector<NodeIndex> switched_near_quiet_rows(const NodeStore& nodes, std::size_t real, const GhostSet& ghosts) const;
     // `rows` (ascending) join the rows due; then, as choose_rows does, a full search instead
     // where the rows due are many or the candidates have grown by a quarter.
