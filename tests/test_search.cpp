@@ -251,6 +251,38 @@ TEST(Search, AFixedCentreFarFromOtherBodiesAndVariableNodesIsQuiet) {
     expect_same_sets(lists, find_neighbours_brute_force(n, 1.0, n.size()));
 }
 
+// A fixed centre one of whose lattice neighbours has switched is not quiet, even where that
+// neighbour has left its cells: the cut keeps a quiet row whole (filter_candidates), and the
+// switched neighbour is a pair only within reach. Here the neighbour of a deep node of body 0 has
+// been carried far below the blocks; the cut of the candidates must give the all-pairs lists,
+// without that pair (until 2026-12-07 the deep node was quiet and kept it).
+TEST(Search, AFixedCentreWhoseLatticeNeighbourSwitchedIsNotQuiet) {
+    NodeStore n = two_fixed_blocks_and_a_variable_one();
+    const std::size_t deep = 3 * 15 + 3, neighbour = 3 * 15 + 4;
+    const auto lattice = n.fixed_neighbours.row(deep);
+    ASSERT_NE(std::find(lattice.begin(), lattice.end(), static_cast<NodeIndex>(neighbour)), lattice.end());
+    n.connectivity[neighbour] = Connectivity::Variable;
+    n.position[1][neighbour] = -0.5;  // 25 spacings below the blocks, far beyond reach
+    NeighbourScratch scratch;
+    CompressedRows candidates, cut;
+    find_neighbours(n, 1.0, n.size(), candidates, scratch, nullptr, 0.01, true);
+    EXPECT_EQ(scratch.quiet[deep], 0) << "a lattice neighbour has switched";
+    EXPECT_EQ(scratch.quiet[3 * 15 + 10], 1) << "a deep node whose lattice neighbours are fixed stays quiet";
+    std::vector<std::uint32_t> lattice_entries(n.size(), 0);
+    for (std::size_t i = 0; i < n.size(); ++i) {
+        if (n.connectivity[i] == Connectivity::Fixed) lattice_entries[i] = static_cast<std::uint32_t>(n.fixed_neighbours.row_size(i));
+    }
+    std::vector<std::uint64_t> keep;
+    LatticeRowsKept kept;
+    kept.switching = true;
+    kept.quiet = scratch.quiet.data();
+    kept.quiet_rows = scratch.quiet.size();
+    filter_candidates(n, 1.0, candidates, lattice_entries, cut, keep, kept);
+    const auto row = cut.row(deep);
+    EXPECT_EQ(std::find(row.begin(), row.end(), static_cast<NodeIndex>(neighbour)), row.end());
+    expect_same_sets(cut, find_neighbours_brute_force(n, 1.0, n.size()));
+}
+
 // The rows of some centres alone (find_neighbours with `only`, NeighbourLists::search_rows) are
 // entry for entry the rows a search of every centre gives them: lattice rows, quiet and not,
 // candidates with a skin, outsized nodes; centres that do not ascend are refused.

@@ -420,7 +420,7 @@ TEST(NeighbourSkin, OnlyTheRowsOfNodesThatMovedAreSearchedAgainAndTheListsStayTh
 // pair put into both rows (NeighbourLists::switched_near_quiet_rows, search_rows), not every row:
 // a bar struck by a fast body, whose face switches to variable connectivity while the rest of the
 // bar stays quiet, needs about the full searches of the same bar all-variable, which has no quiet
-// rows (a switch made every row stale until 2026-12-07: 7 full searches against 1). Every step's
+// rows (until 2026-12-07 a switch called a full search: 7 against all-variable's 1). Every step's
 // lists are those of a full search (check_neighbour_lists), and the run is bit-identical on 1 and
 // 2 threads.
 TEST(NeighbourSkin, ASwitchNextToAQuietCentreSearchesTheSwitchedRowsAlone) {
@@ -443,7 +443,8 @@ TEST(NeighbourSkin, ASwitchNextToAQuietCentreSearchesTheSwitchedRowsAlone) {
     }
     const Totals& automatic = totals[ConnectivityMode::Automatic];
     const Totals& variable = totals[ConnectivityMode::Variable];
-    ASSERT_GT(automatic.variable_nodes, 40u) << "the struck face must switch";  // the shot's nodes and the bar's face
+    // The shot's few nodes (it is two spacings across) and the bar's struck face.
+    ASSERT_GT(automatic.variable_nodes, 40u) << "the struck face must switch";
     ASSERT_LT(automatic.variable_nodes, automatic.real_nodes / 4) << "the rest of the bar must stay fixed";
     // One more than all-variable: rows searched alone keep their old entries, and when the
     // candidates have grown by a quarter since the last full search (the quiet rows grow from

@@ -290,13 +290,21 @@ void find_neighbours(const NodeStore& nodes, InfluenceDistance influence, std::s
     // Calls emit(j) for every neighbour j of centre i, in the order described in the header.
     const auto visit = [&](std::size_t i, auto&& emit) {
         const bool fixed = nodes.connectivity[i] == Connectivity::Fixed;
+        // Every lattice neighbour still fixed: a centre can be quiet only then (below), since the
+        // cut keeps a quiet row whole, and a lattice neighbour that has switched is a pair only
+        // within reach, which the box below need not cover once the lattice has stretched.
+        bool lattice_fixed = true;
         if (fixed) {
             for (NodeIndex j : nodes.fixed_neighbours.row_or_empty(i)) {
-                if (candidates || nodes.connectivity[j] == Connectivity::Fixed) emit(j);
+                const bool fixed_j = nodes.connectivity[j] == Connectivity::Fixed;
+                lattice_fixed &= fixed_j;
+                if (candidates || fixed_j) emit(j);
             }
             if (extra_fixed) {
                 for (NodeIndex j : extra_fixed->row_or_empty(i)) {
-                    if (candidates || nodes.connectivity[j] == Connectivity::Fixed) emit(j);  // a ghost has its source's mode
+                    const bool fixed_j = nodes.connectivity[j] == Connectivity::Fixed;  // a ghost has its source's mode
+                    lattice_fixed &= fixed_j;
+                    if (candidates || fixed_j) emit(j);
                 }
             }
         }
@@ -331,7 +339,7 @@ void find_neighbours(const NodeStore& nodes, InfluenceDistance influence, std::s
         const auto scan = [&](const CellGrid& g, std::size_t cells_around, double distance) {
             std::array<std::size_t, 3> lo{0, 0, 0}, hi{0, 0, 0};
             box(g, cells_around, lo, hi);
-            if (fixed && &g == &grid && quiet_box(lo, hi)) {
+            if (fixed && lattice_fixed && &g == &grid && quiet_box(lo, hi)) {
                 if (candidates) scratch.quiet[i] = 1;
                 return;
             }

@@ -96,13 +96,23 @@ void NeighbourLists::place_ghosts(NodeStore& nodes, std::size_t real, GhostSet& 
         if (s.ghosts_short || !std::isfinite(s.largest_budget)) {
             search_due_ = true;
         } else {
-            if (!s.common_bound_holds && !(3.0 * s.largest_budget + rounding < skin_)) {
-                // Neither bound holds (the header): search the rows that have moved, or all.
+            // The rows of nodes that have switched next to a quiet centre (or were quiet
+            // themselves), and those quiet centres: searched alone, each of their pairs goes into
+            // both rows.
+            const std::vector<NodeIndex> switched = switched_near_quiet_rows(nodes, real, ghosts);
+            // Rows searched alone leave only the per-row bound (the header), whose argument needs
+            // every row's budget within a third of the skin from the moment a row is searched
+            // alone: where the common bound held, the budgets have not been measured yet.
+            double largest = s.largest_budget;
+            if (s.common_bound_holds && !switched.empty()) largest = largest_budget(nodes, real, influence_distance.value());
+            if (!std::isfinite(largest)) {
+                search_due_ = true;
+            } else if ((!s.common_bound_holds || !switched.empty()) && !(3.0 * largest + rounding < skin_)) {
+                // Neither bound holds, or the per-row one is about to serve alone and does not:
+                // search the rows that have moved, or all.
                 choose_rows(nodes, real, influence_distance);
             }
-            // The rows of nodes that have switched next to a quiet centre (or were quiet
-            // themselves) join them: searched, each of their pairs goes into both rows.
-            if (!search_due_) add_rows_due(switched_near_quiet_rows(nodes, real, ghosts), real);
+            if (!search_due_) add_rows_due(switched, real);
         }
     }
     if (ghosts.empty()) return;
@@ -136,6 +146,23 @@ double NeighbourLists::row_budget(const NodeStore& nodes, std::size_t i, double 
         u2 += u * u;
     }
     return std::sqrt(u2) + a * std::abs(nodes.diameter[i] - searched_diameter_[i]);
+}
+
+double NeighbourLists::largest_budget(const NodeStore& nodes, std::size_t real, double a) const {
+    // The per-row budget (the header): |u_i| + a |d_i - d_then,i|, each row from its own search;
+    // NaN with a NaN position or diameter (place_ghosts then searches in full).
+    return tbb::parallel_reduce(
+        tbb::blocked_range<std::size_t>(0, real, costly_node_grain), 0.0,
+        [&](const tbb::blocked_range<std::size_t>& r, double acc) {
+            for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                const double budget = row_budget(nodes, i, a);
+                // A NaN, once met, stays: std::max would drop it, and so would a test that lets a
+                // later finite budget replace it (as this one did, unless the NaN ended its task).
+                if (!std::isnan(acc) && !(budget <= acc)) acc = budget;
+            }
+            return acc;
+        },
+        [](double x, double y) { return std::isnan(x) ? x : (std::isnan(y) || y > x ? y : x); });
 }
 
 NeighbourLists::Staleness NeighbourLists::staleness(const NodeStore& nodes, std::size_t real, const GhostSet& ghosts,
@@ -202,20 +229,7 @@ NeighbourLists::Staleness NeighbourLists::staleness(const NodeStore& nodes, std:
         out.common_bound_holds = closing + 2.0 * a * e.growth < skin_;
         if (out.common_bound_holds) return out;
     }
-    // The per-row budget (the header): |u_i| + a |d_i - d_then,i|, each row from its own search;
-    // NaN with a NaN position or diameter (place_ghosts then searches in full).
-    out.largest_budget = tbb::parallel_reduce(
-        tbb::blocked_range<std::size_t>(0, real, costly_node_grain), 0.0,
-        [&](const tbb::blocked_range<std::size_t>& r, double acc) {
-            for (std::size_t i = r.begin(); i != r.end(); ++i) {
-                const double budget = row_budget(nodes, i, a);
-                // A NaN, once met, stays: std::max would drop it, and so would a test that lets a
-                // later finite budget replace it (as this one did, unless the NaN ended its task).
-                if (!std::isnan(acc) && !(budget <= acc)) acc = budget;
-            }
-            return acc;
-        },
-        [](double x, double y) { return std::isnan(x) ? x : (std::isnan(y) || y > x ? y : x); });
+    out.largest_budget = largest_budget(nodes, real, a);
     return out;
 }
 
@@ -252,21 +266,15 @@ void NeighbourLists::add_rows_due(const std::vector<NodeIndex>& rows, std::size_
 
 std::vector<NodeIndex> NeighbourLists::switched_near_quiet_rows(const NodeStore& nodes, std::size_t real,
                                                                 const GhostSet& ghosts) const {
-    // A quiet row lacks the fixed nodes of its body that are not its lattice neighbours; they
-    // become pairs only when one of the two switches. A node that switched since its row was
-    // searched and was itself quiet lacks them all; one that was not holds every node within its
-    // reach in its candidates, so the quiet centres within its reach are in its row (a ghost entry
-    // names its source, whose row has the mirror image of the pair), and they lack it. A search of
-    // the switched node's row finds every node within its reach and puts each pair into both rows
-    // (search_rows): the quiet rows gain the pairs the switch made, and nothing else changed for
-    // them (their other fixed nodes are still no pairs of theirs). The quiet centres in its row
-    // are searched too: a quiet row is kept whole by the cut (filter_candidates), and one whose
-    // lattice neighbour switched would keep that pair however far it stretched (its row gains
-    // nothing, the pair is there already); searched, such a row holds every node within its reach
-    // and is no longer quiet. (A quiet centre farther than the switched node's lattice neighbours
-    // is not in the row of a switched node that was quiet itself: it gains the new pair at the end
-    // of its row, which the cut then takes entry by entry, and stays quiet, still lacking the
-    // rest.) So those rows, ascending, each once.
+    // A quiet row holds its lattice neighbours alone: it lacks the other fixed nodes of its body
+    // within reach, which become pairs only when one of the two switches, and the cut keeps it
+    // whole. A node that has switched since its row was searched is due if it was quiet (its
+    // row lacks them all) or if its candidates hold a quiet centre (a ghost entry names its
+    // source); so is that quiet centre. Searched alone, each row gains its pairs, each put into
+    // both rows (search_rows), and the quiet centre, now next to a variable node or with a
+    // switched lattice neighbour, is quiet no more (find_neighbours). A quiet centre farther than
+    // a quiet switched node's lattice neighbours gains the new pair at the end of its row, which
+    // the cut then takes entry by entry. The rows ascending, each once.
     using Rows = std::vector<NodeIndex>;
     if (!any_quiet_) return {};
     Rows rows = tbb::parallel_reduce(

@@ -123,6 +123,8 @@ private:
     Staleness staleness(const NodeStore& nodes, std::size_t real, const GhostSet& ghosts, InfluenceDistance influence_distance,
                         double rounding) const;
     double row_budget(const NodeStore& nodes, std::size_t i, double a) const;
+    // The largest row_budget of the real rows; NaN where a position or diameter is NaN.
+    double largest_budget(const NodeStore& nodes, std::size_t real, double a) const;
     // The rows whose budget is above a sixth of the skin; a full search instead when they are many.
     void choose_rows(const NodeStore& nodes, std::size_t real, InfluenceDistance influence_distance);
     void search_rows(NodeStore& nodes, std::size_t real, GhostSet& ghosts, InfluenceDistance influence_distance, bool any_automatic);

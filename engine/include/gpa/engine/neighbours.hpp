@@ -51,12 +51,13 @@ struct NeighbourScratch {
     // kMixedCell (a variable node, or nodes of two bodies).
     std::vector<std::int32_t> cell_body;
     static constexpr std::int32_t kEmptyCell = -1, kMixedCell = -2;
-    // Per centre, after a search with fixed_may_switch: 1 when the centre is fixed and every
-    // bulk cell within its reach held only fixed nodes of its body (a quiet centre). Its row then
-    // holds its lattice neighbours and mirrors (and any outsized node within reach), not the
-    // other fixed nodes of its body that would become pairs only if one of the two switched:
-    // the lists are valid until a node within reach of a quiet centre switches (NeighbourLists
-    // searches again then). Without fixed_may_switch a quiet centre's scan would find no pair,
+    // Per centre, after a search with fixed_may_switch: 1 when the centre is fixed, its lattice
+    // neighbours and mirrors are all fixed, and every bulk cell within its reach held only fixed
+    // nodes of its body (a quiet centre). Its row then holds its lattice neighbours and mirrors
+    // (and any outsized node within reach), not the other fixed nodes of its body that would
+    // become pairs only if one of the two switched: the lists are valid until a node within
+    // reach of a quiet centre, or one of its lattice neighbours, switches (NeighbourLists searches
+    // the switched node's row and the quiet centre's then). Without fixed_may_switch a quiet centre's scan would find no pair,
     // and is skipped too (the lists are the same).
     std::vector<std::uint8_t> quiet;
     // Called with the number of entries the lists hold so far, after each wave of rows is made
