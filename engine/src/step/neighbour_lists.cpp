@@ -503,10 +503,9 @@ void NeighbourLists::update(NodeStore& nodes, std::size_t real, GhostSet& ghosts
         } else if (!rows_due_.empty()) {
             search_rows(nodes, real, ghosts, influence_distance, any_automatic);
         }
-        // The quiet rows' lattice pairs are whole until a node near one of them switches, which
-        // place_ghosts turns into a search of the switched node's row before this cut
-        // (switched_near_quiet_rows); the quiet row, then longer than its lattice entries, is cut
-        // entry by entry.
+        // The quiet rows' lattice pairs are whole until a node near one of them, or one of their
+        // lattice neighbours, switches: place_ghosts then makes the switched node's row and the
+        // quiet centres in it due, searched before this cut (switched_near_quiet_rows).
         LatticeRowsKept kept_rows;
         kept_rows.switching = any_automatic;
         kept_rows.quiet = quiet_.data();

@@ -56,9 +56,9 @@ struct NeighbourScratch {
     // nodes of its body (a quiet centre). Its row then holds its lattice neighbours and mirrors
     // (and any outsized node within reach), not the other fixed nodes of its body that would
     // become pairs only if one of the two switched: the lists are valid until a node within
-    // reach of a quiet centre, or one of its lattice neighbours, switches (NeighbourLists searches
-    // the switched node's row and the quiet centre's then). Without fixed_may_switch a quiet centre's scan would find no pair,
-    // and is skipped too (the lists are the same).
+    // reach of a quiet centre, or one of its lattice neighbours, switches (NeighbourLists then
+    // searches the switched node's row and the quiet centre's). Without fixed_may_switch a quiet
+    // centre's scan would find no pair, and is skipped too (the lists are the same).
     std::vector<std::uint8_t> quiet;
     // Called with the number of entries the lists hold so far, after each wave of rows is made
     // and before it is placed, the last time with them all; may throw (a memory limit,
