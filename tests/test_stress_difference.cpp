@@ -195,13 +195,13 @@ TEST(StressDifference, EnergyStaysBoundedInABlockClosedOnEverySide) {
     block.size = {4e-3, 4e-3, 0.0};
     block.velocity = {20.0, 0.0, 0.0};
     s.planes.clear();
-    const auto plane = [](const char* name, PlaneKind kind, int axis, double position, int side) {
+    const auto plane = [](const char* name, PlaneKind kind, int axis, double position, int facing) {
         PlaneSpec p;
         p.name = name;
         p.kind = kind;
         p.axis = axis;
         p.position = position;
-        p.side = side;
+        p.side = facing;
         p.lift_off = false;
         return p;
     };
