@@ -366,20 +366,12 @@ void stress_difference_impl(const CompressedRows& lists, const ScatterPlan& plan
 }
 
 // `CurvedDamping`: the hourglass damping's kept fits may have second derivatives (the quadratic
-// fit; KeptDampingPower), chosen once for the pass; `WithBond`: StressPowerOut::bond is set;
-// `Mean`: StressPowerOut::mean_with is set.
-template <class G, class W, bool CurvedDamping, bool WithBond, bool Mean>
+// fit; KeptDampingPower), chosen once for the pass; `WithBond`: StressPowerOut::bond is set.
+template <class G, class W, bool CurvedDamping, bool WithBond>
 void stress_power_impl(const CompressedRows& lists, const ForceFields<G::dim>& f,
-                       const std::array<const double*, G::dim>& velocity_field, std::size_t n, const StressPowerOut& out,
+                       const std::array<const double*, G::dim>& velocity, std::size_t n, const StressPowerOut& out,
                        const HourglassFields<G::dim>* hourglass, double hourglass_coefficient) {
     constexpr int D = G::dim;
-    const auto velocity_of = [&](std::size_t k) {
-        Vec<D> v = load<D>(velocity_field, k);
-        if constexpr (Mean) {
-            for (int c = 0; c < D; ++c) v[c] = 0.5 * (v[c] + out.mean_with[c][k]);
-        }
-        return v;
-    };
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, row_grain), [&](const tbb::blocked_range<std::size_t>& range) {
         for (std::size_t i = range.begin(); i != range.end(); ++i) {
             const Mat<D> sigma = cauchy_stress<G>(f.deviatoric_stress, f.pressure, f.viscous_pressure, i);
@@ -387,7 +379,7 @@ void stress_power_impl(const CompressedRows& lists, const ForceFields<G::dim>& f
                                                               : Mat<D>(load<D>(f.alpha, i).asDiagonal());
             const double q = f.viscous_pressure ? f.viscous_pressure[i] : 0.0;
             const double volume = f.volume[i];
-            const Vec<D> v_i = velocity_of(i);
+            const Vec<D> v_i = load<D>(velocity, i);
             // The row's sum of velocity differences B_i (kernels.hpp, accumulate_velocity_difference):
             // power -V_i (sigma_i N_i) : B_i, divergence N_i : B_i, no pair force made.
             Mat<D> difference = Mat<D>::Zero();
@@ -411,7 +403,7 @@ void stress_power_impl(const CompressedRows& lists, const ForceFields<G::dim>& f
             for (std::size_t k = 0; k < row.size(); ++k) {
                 const NodeIndex j = row[k];
                 const auto p = f.pairs.template pair<W>(i, j, first + k);
-                Vec<D> dv = velocity_of(j) - v_i;
+                Vec<D> dv = load<D>(velocity, j) - v_i;
                 const bool sliding = f.pairs.sliding(i, j);
                 [[maybe_unused]] Vec<D> normal;
                 if (sliding) {
@@ -480,13 +472,8 @@ void compute_stress_power(const CompressedRows& lists, WeightKind weight, const 
     }
     dispatch_weight(weight, [&](auto w) {
         const auto run = [&](auto curved, auto with_bond) {
-            if (out.mean_with[0]) {
-                stress_power_impl<G, decltype(w), decltype(curved)::value, decltype(with_bond)::value, true>(
-                    lists, f, velocity, real_count, out, hourglass, hourglass_coefficient);
-            } else {
-                stress_power_impl<G, decltype(w), decltype(curved)::value, decltype(with_bond)::value, false>(
-                    lists, f, velocity, real_count, out, hourglass, hourglass_coefficient);
-            }
+            stress_power_impl<G, decltype(w), decltype(curved)::value, decltype(with_bond)::value>(lists, f, velocity, real_count, out,
+                                                                                                 hourglass, hourglass_coefficient);
         };
         const bool curved = hourglass && hourglass->quadratic;
         if (out.bond) {

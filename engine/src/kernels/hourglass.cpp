@@ -261,13 +261,9 @@ HourglassPower centre_control(std::span<const NodeIndex> row, std::size_t i, con
     const Vec<D> x_i = load(f.position, i), v_i = load(f.velocity, i);
     const bool other_velocity = f.power_velocity[0] != nullptr;
     const bool scatter = f.force[0] != nullptr;
-    // The velocity the power is taken at (HourglassFields::power_velocity, power_at_mean).
-    const auto power_velocity_of = [&](std::size_t k) {
-        return f.power_at_mean ? (0.5 * (load(f.velocity, k) + load(f.power_velocity, k))).eval() : load(f.power_velocity, k);
-    };
-    const Vec<D> w_i = other_velocity ? power_velocity_of(i) : Vec<D>::Zero().eval();
+    const Vec<D> w_i = other_velocity ? load(f.power_velocity, i) : Vec<D>::Zero().eval();
     const auto power_of = [&](NodeIndex j, const Vec<D>& force_on_j, const Vec<D>& dv) {
-        return force_on_j.dot(other_velocity ? (power_velocity_of(j) - w_i).eval() : dv);
+        return force_on_j.dot(other_velocity ? (load(f.power_velocity, j) - w_i).eval() : dv);
     };
     Vec<D> on_centre = Vec<D>::Zero();
     // A neighbourhood that gives no fit in some direction (a single row or column of nodes)

@@ -58,7 +58,7 @@ void EnergyLedger::keep_hourglass_fits(HourglassFields<D>& control, std::size_t 
 }
 
 void EnergyLedger::keep_half_step_velocities(const NodeStore& nodes) {
-    if (!compatible_) return;
+    if (!(compatible_ && (hourglass_ || bond_))) return;
     // Ghosts included (their mirrored velocities): the control pairs the ghosts that continue a body
     // across a symmetry plane (hourglass.hpp, ghost_continues), and the booking reads them too.
     for (int c = 0; c < nodes.dim(); ++c) half_velocity_[c].assign(nodes.velocity[c].begin(), nodes.velocity[c].end());
@@ -67,7 +67,8 @@ void EnergyLedger::keep_half_step_velocities(const NodeStore& nodes) {
 template <class G>
 void EnergyLedger::compatible_powers(const CompressedRows& lists, WeightKind weight, const ForceFields<G::dim>& forces,
                                      std::optional<HourglassFields<G::dim>> control, double hourglass_coefficient,
-                                     NodeStore& nodes, std::size_t real, double dt_avg, GhostSet& ghosts) {
+                                     NodeStore& nodes, std::size_t real, double dt_avg, const HeldNodes& held,
+                                     const std::vector<PrescribedVelocitySpec>& regions, GhostSet& ghosts) {
     // Spec section 5, "[spec] Compatible energy": the internal energy of a node changes by the work
     // its stress forces do in this velocity update, at the mean of the half-step velocities before
     // and after it, v_mean = v^{n+3/2} - dt_avg F / (2 M): exactly the kinetic energy those forces
@@ -76,22 +77,26 @@ void EnergyLedger::compatible_powers(const CompressedRows& lists, WeightKind wei
     // difference is first order in dt wherever stress and strain rate are large at once: +3 % of the
     // energy within 0.4 us of a 4 km/s impact at C_cfl 0.4, +1.5 % at 0.2.)
     constexpr int D = G::dim;
-    // The mean velocity of the update, (v^{n+1/2} + v^{n+3/2}) / 2 = v^{n+3/2} - dt_avg F / (2 M),
-    // is made where the pass reads it, from the kept half-step velocities and the new ones (no
-    // array of its own: 8 bytes per node and component). For a held component (prescribed.hpp),
-    // which went from v^{n+1/2} to the prescribed v^{n+3/2} and not by dt_avg F / M, it is the mean
-    // of the two all the same, so that the regions' work (the reaction's, at the same mean) and this
-    // booking together give its kinetic-energy change exactly. The ghosts take their sources' new
-    // velocities, mirrored, as the half-step ones were (a reflection is exact, so a ghost's mean is
-    // its source's, mirrored, bit for bit); the next step places the ghosts again before any other
-    // phase reads them.
-    const std::array<double*, 3> velocity_out{nodes.velocity[0].data(), nodes.velocity[1].data(), D == 3 ? nodes.velocity[2].data() : nullptr};
-    if (!ghosts.empty()) ghosts.mirror_vector_field(velocity_out, D, real);
-    std::array<const double*, D> velocity{}, half{};
-    for (int c = 0; c < D; ++c) {
-        velocity[c] = nodes.velocity[c].data();
-        half[c] = half_velocity_[c].data();
+    for (int c = 0; c < D; ++c) resize_with_slack(mean_velocity_[c], nodes.size());
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, real, costly_node_grain), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (int c = 0; c < D; ++c) {
+            const double* v = nodes.velocity[c].data();
+            const double* f = nodes.force[c].data();
+            double* mean = mean_velocity_[c].data();
+            for (std::size_t i = r.begin(); i != r.end(); ++i) mean[i] = v[i] - 0.5 * dt_avg * f[i] / nodes.mass[i];
+        }
+    });
+    const std::array<double*, 3> mean_out{mean_velocity_[0].data(), mean_velocity_[1].data(), D == 3 ? mean_velocity_[2].data() : nullptr};
+    // Held components (prescribed.hpp) went from v^{n+1/2} to the prescribed v^{n+3/2}, not by
+    // dt_avg F / M: their mean is that of the two, so that the regions' work (the reaction's, at the
+    // same mean) and this booking together give their kinetic-energy change exactly.
+    if (!held.empty()) {
+        held.set_mean_velocity(regions, D, {nodes.velocity[0].data(), nodes.velocity[1].data(), D == 3 ? nodes.velocity[2].data() : nullptr},
+                               mean_out);
     }
+    if (!ghosts.empty()) ghosts.mirror_vector_field(mean_out, D, real);
+    std::array<const double*, D> mean{};
+    for (int c = 0; c < D; ++c) mean[c] = mean_velocity_[c].data();
     // The hourglass forces' power in the same pass (made from the half-step velocities, as in the
     // force pass, their power taken at the mean velocities: the kinetic energy they remove in this
     // update).
@@ -102,11 +107,10 @@ void EnergyLedger::compatible_powers(const CompressedRows& lists, WeightKind wei
         control->power = hourglass_power_.data();
         control->stiffness_power = stiffness_ ? stiffness_power_.data() : nullptr;
         for (int c = 0; c < D; ++c) {
-            control->velocity[c] = half[c];
+            control->velocity[c] = half_velocity_[c].data();
             control->force[c] = nullptr;
-            control->power_velocity[c] = velocity[c];
+            control->power_velocity[c] = mean[c];
         }
-        control->power_at_mean = true;
     }
     // The stress work and its nodal-viscosity share booked in the same pass (StressPowerOut), first of
     // the step's bookings as book() once did them: the same operations in the same order per node.
@@ -115,16 +119,15 @@ void EnergyLedger::compatible_powers(const CompressedRows& lists, WeightKind wei
     booking.viscous_work = nodes.viscous_work.data();
     booking.mass = nodes.mass.data();
     booking.dt = dt_avg;
-    for (int c = 0; c < D; ++c) booking.mean_with[c] = half[c];
     if (bond_) {
         // The bond-viscous forces' work at the mean velocities (their Q_ij from the half-step
         // velocities the force pass made them with), in place of the force pass's power at v^{n+1/2}:
         // exactly the kinetic energy they take out in this update.
         booking.bond = &bond_parameters_;
-        for (int c = 0; c < D; ++c) booking.bond_velocity[c] = half[c];
+        for (int c = 0; c < D; ++c) booking.bond_velocity[c] = half_velocity_[c].data();
         booking.bond_power = bond_power_.data();
     }
-    compute_stress_power<G>(lists, weight, forces, velocity, real, booking, control ? &*control : nullptr, hourglass_coefficient);
+    compute_stress_power<G>(lists, weight, forces, mean, real, booking, control ? &*control : nullptr, hourglass_coefficient);
 }
 
 void EnergyLedger::book(NodeStore& nodes, std::size_t real, double dt_avg) {
@@ -172,8 +175,9 @@ void EnergyLedger::memory_use(MemoryUse& out) const {
     add_memory(out, "energy ledger: powers per node", allocated_bytes(bond_power_) + allocated_bytes(hourglass_power_) +
                                                           allocated_bytes(stiffness_power_));
     std::size_t velocities = 0;
+    for (const auto& v : mean_velocity_) velocities += allocated_bytes(v);
     for (const auto& v : half_velocity_) velocities += allocated_bytes(v);
-    add_memory(out, "energy ledger: half-step velocities", velocities);
+    add_memory(out, "energy ledger: mean and half-step velocities", velocities);
     std::size_t fits = 0;
     for (const auto& v : damping_fit_) fits += allocated_bytes(v);
     for (const auto& v : stiffness_fit_) fits += allocated_bytes(v);
@@ -196,13 +200,15 @@ void EnergyLedger::read_state(StateReader& in) { state_fields(in, *this); }
 
 template void EnergyLedger::compatible_powers<PlaneStrain>(const CompressedRows&, WeightKind, const ForceFields<2>&,
                                                            std::optional<HourglassFields<2>>, double, NodeStore&, std::size_t,
-                                                           double, GhostSet&);
+                                                           double, const HeldNodes&, const std::vector<PrescribedVelocitySpec>&,
+                                                           GhostSet&);
 template void EnergyLedger::compatible_powers<Axisymmetric>(const CompressedRows&, WeightKind, const ForceFields<2>&,
                                                             std::optional<HourglassFields<2>>, double, NodeStore&, std::size_t,
-                                                            double, GhostSet&);
+                                                            double, const HeldNodes&, const std::vector<PrescribedVelocitySpec>&,
+                                                            GhostSet&);
 template void EnergyLedger::compatible_powers<ThreeD>(const CompressedRows&, WeightKind, const ForceFields<3>&,
                                                       std::optional<HourglassFields<3>>, double, NodeStore&, std::size_t, double,
-                                                      GhostSet&);
+                                                      const HeldNodes&, const std::vector<PrescribedVelocitySpec>&, GhostSet&);
 
 template void EnergyLedger::keep_hourglass_fits<2>(HourglassFields<2>&, std::size_t);
 template void EnergyLedger::keep_hourglass_fits<3>(HourglassFields<3>&, std::size_t);

@@ -49,15 +49,14 @@ public:
     void keep_hourglass_fits(HourglassFields<D>& control, std::size_t count);
 
     // Before the velocity update: v^{n+1/2} of the nodes, from which the force pass made the
-    // hourglass and bond-viscous forces, and the half of the mean velocity of the update at which
-    // compatible_powers takes every power. Only with the compatible update.
+    // hourglass and bond-viscous forces (their power is taken at the mean velocities later). Only
+    // when needed.
     void keep_half_step_velocities(const NodeStore& nodes);
 
     // After the velocity update and the prescribed components (compatible update only): the work of
     // each centre's stress forces and, with bond viscosity or the hourglass control, of those forces
-    // at the mean velocities v_mean = (v^{n+1/2} + v^{n+3/2}) / 2 (held components too; ghosts
-    // mirrored: their velocities become their sources' new ones), in one visit of every row
-    // (drivers.hpp, compute_stress_power). The
+    // at the mean velocities v_mean = v^{n+3/2} - dt_avg F / (2 M) (held components: the mean of their two half
+    // steps; ghosts mirrored), in one visit of every row (drivers.hpp, compute_stress_power). The
     // stress work and its nodal-viscosity share are booked into the nodes in that visit, the first
     // of the step's bookings (book() does the rest); the bond-viscous and the control's powers go to
     // the ledger's arrays, replacing the force pass's.
@@ -66,7 +65,8 @@ public:
     template <class G>
     void compatible_powers(const CompressedRows& lists, WeightKind weight, const ForceFields<G::dim>& forces,
                            std::optional<HourglassFields<G::dim>> control, double hourglass_coefficient, NodeStore& nodes,
-                           std::size_t real, double dt_avg, GhostSet& ghosts);
+                           std::size_t real, double dt_avg, const HeldNodes& held,
+                           const std::vector<PrescribedVelocitySpec>& regions, GhostSet& ghosts);
 
     // Books the step's work and heat into the real nodes (one pass, in a fixed order per node and a
     // fixed order of the sums, so that nothing depends on the thread count): bond-viscous heat,
@@ -100,6 +100,7 @@ private:
     double hourglass_work_ = 0.0;
     double hourglass_energy_ = 0.0;
     std::vector<double> bond_power_, hourglass_power_, stiffness_power_;  // per node of the force pass
+    std::array<std::vector<double>, 3> mean_velocity_;                    // per node, ghosts mirrored
     std::array<std::vector<double>, 3> half_velocity_;                    // per node, ghosts included
     // The force pass's hourglass fits per real node: the scale, then the D * D matrix entries.
     std::array<std::vector<double>, 10> damping_fit_, stiffness_fit_;

@@ -97,4 +97,16 @@ std::vector<RegionStep> HeldNodes::impose(const std::vector<PrescribedVelocitySp
     return out;
 }
 
+void HeldNodes::set_mean_velocity(const std::vector<PrescribedVelocitySpec>& regions, int dim,
+                                  const std::array<const double*, 3>& velocity, const std::array<double*, 3>& mean) const {
+    for (std::size_t k = 0; k < regions.size() && k < nodes_.rows(); ++k) {
+        for (std::size_t e = nodes_.offsets[k]; e < nodes_.offsets[k + 1]; ++e) {
+            const NodeIndex i = nodes_.indices[e];
+            for (int c = 0; c < dim; ++c) {
+                if (regions[k].velocity[c]) mean[c][i] = 0.5 * (before_[e * dim + c] + velocity[c][i]);
+            }
+        }
+    }
+}
+
 }  // namespace gpa

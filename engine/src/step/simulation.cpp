@@ -406,7 +406,7 @@ void Simulation::Impl::integrate(double dt_avg) {
         std::optional<HourglassFields<G::dim>> control;
         if (ledger.hourglass()) control = hourglass_control_fields<G>(nullptr, nullptr);  // the ledger sets the outputs
         ledger.compatible_powers<G>(lists(), scene.solver.weight, f, control, scene.solver.hourglass_coefficient, nodes, real,
-                                    dt_avg, ghosts);
+                                    dt_avg, held, scene.prescribed_velocities, ghosts);
     }
     ledger.book(nodes, real, dt_avg);
 }

@@ -72,10 +72,6 @@ struct StressPowerOut {
     double* viscous_work = nullptr;
     const double* mass = nullptr;
     double dt = 0.0;
-    // Optional: each node's velocity is the mean of the pass's `velocity` and this, (v_a + v_b) / 2,
-    // made where it is read (the compatible update's mean of the half-step velocities on both sides
-    // of an update, without an array of its own).
-    std::array<const double*, 3> mean_with{};
     // Bond viscosity (Eq. 37-38), optional: each pair's Q_ij made again as the force pass made it,
     // from `bond_velocity` (the velocities of the force pass), and the power of its forces at the
     // pass's `velocity` into bond_power[i], per real centre (the compatible booking of the

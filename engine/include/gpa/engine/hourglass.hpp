@@ -64,10 +64,6 @@ struct HourglassFields {
     // sum_j F_j . (w_j - w_i); the compatible energy update books the heat at the mean velocities of
     // the velocity update (docs/energy.md).
     std::array<const double*, D> power_velocity{};
-    // With power_velocity: the velocity the power is taken at is the mean of `velocity` and
-    // power_velocity, (v_a + v_b) / 2, made where it is read (the compatible update's mean of the
-    // half-step velocities on both sides of an update, without an array of its own).
-    bool power_at_mean = false;
     // The fits of the centres, kept from the force pass for the energy booking's pass, which then
     // makes the same forces without fitting again (same positions and velocities, same fit, the same
     // forces bit for bit): per centre, the force scale (kappa_i / sum_k w_k for the damping,
@@ -155,10 +151,9 @@ public:
             }
         }
         other_velocity_ = f.power_velocity[0] != nullptr;
-        at_mean_ = other_velocity_ && f.power_at_mean;
         for (int c = 0; c < D; ++c) {
             v_i_[c] = f.velocity[c][i];
-            if (other_velocity_) w_i_[c] = at_mean_ ? 0.5 * (v_i_[c] + f.power_velocity[c][i]) : f.power_velocity[c][i];
+            if (other_velocity_) w_i_[c] = f.power_velocity[c][i];
         }
     }
     bool active() const { return kappa_ != 0.0; }
@@ -181,11 +176,9 @@ public:
         }
         double power = 0.0;
         for (int a = 0; a < D; ++a) {
-            const double v_j = f.velocity[a][j];
-            const double dv = v_j - v_i_[a];
+            const double dv = f.velocity[a][j] - v_i_[a];
             const double force_on_j = scale * (dv - fitted[a]);
-            const double w_j = at_mean_ ? 0.5 * (v_j + f.power_velocity[a][j]) : (other_velocity_ ? f.power_velocity[a][j] : 0.0);
-            const double dw = other_velocity_ ? w_j - w_i_[a] : dv;
+            const double dw = other_velocity_ ? f.power_velocity[a][j] - w_i_[a] : dv;
             power = a == 0 ? force_on_j * dw : power + force_on_j * dw;
         }
         return power;
@@ -200,7 +193,6 @@ private:
     std::size_t i_ = 0;
     double kappa_ = 0.0;
     bool other_velocity_ = false;
-    bool at_mean_ = false;  // HourglassFields::power_at_mean
     Mat<D> fitted_gradient_ = Mat<D>::Zero();
     Vec<D> v_i_ = Vec<D>::Zero(), w_i_ = Vec<D>::Zero();
     [[no_unique_address]] std::conditional_t<Curved, CurvedPart, NoCurvature> curved_;

@@ -26,9 +26,8 @@
 // and with it the energy balance of a held node is that of a free one (docs/elements.md books its
 // plane constraints the same way). With the compatible energy update (docs/energy.md) the internal
 // energy is the work of the forces at the mean velocities of the update, (v^{n+1/2} + v^{n+3/2}) / 2
-// for the held components too (EnergyLedger::compatible_powers makes it from both), so that the F
-// and R parts together are the held node's kinetic-energy change and the balance of a pulled
-// elastic bar closes to round-off.
+// for the held components too (set_mean_velocity), so that the F and R parts together are the held
+// node's kinetic-energy change and the balance of a pulled elastic bar closes to round-off.
 //
 // The penetration guard of the move phase still acts on held nodes; validate_scene refuses regions
 // that would drive nodes touching a plane along its normal.
@@ -80,6 +79,12 @@ public:
     // the held nodes in a fixed order, so that the sums do not depend on the thread count.
     std::vector<RegionStep> impose(const std::vector<PrescribedVelocitySpec>& regions, int dim, double time, double dt_avg,
                                    const std::array<double*, 3>& velocity, const double* mass) const;
+
+    // After impose: the held components of `mean` set to (v^{n+1/2} + v^{n+3/2}) / 2, the velocity
+    // the held nodes' forces work with over the update (the compatible energy update books the
+    // internal energy with it; simulation.cpp).
+    void set_mean_velocity(const std::vector<PrescribedVelocitySpec>& regions, int dim,
+                           const std::array<const double*, 3>& velocity, const std::array<double*, 3>& mean) const;
 
 private:
     CompressedRows nodes_;
