@@ -24,8 +24,13 @@ struct Shape {
     double length = 0.0, footprint = 0.0, narrowest = 0.0, widest = 0.0, peak = 0.0;
 };
 
+// The element solver's balance closes to the integrator's order, not to round-off
+// (docs/elements.md, "Rigid planes"; its own tests bound it at 1e-3): 3.4e-5 and 4.5e-5 measured on
+// the bars of TheCopperAndSteelBarsAgreeWithTheElementsAtMatchedSpacing.
+constexpr double element_energy_bound = 1e-3;
+
 // The scene run to rest, the peaks averaged over two spacings in both geometries.
-Shape run(Scene s, const std::string& label) {
+Shape run(Scene s, const std::string& label, double energy_bound = 1e-12) {
     s.output.peak_radius = 2.0 * s.bodies[0].spacing;
     Simulation sim(s, 2);
     while (!sim.finished()) sim.step();
@@ -34,7 +39,7 @@ Shape run(Scene s, const std::string& label) {
     // Every option these runs use (rings and trimmed cells, the stretch diameters, the damping on
     // every node, symmetry planes through the body) books its work in the compatible update: the
     // balance closes to round-off over the whole run (about 1e-14 measured).
-    EXPECT_LT(std::abs(t.energy_error), 1e-12) << label;
+    EXPECT_LT(std::abs(t.energy_error), energy_bound) << label;
     const Shape out{t.length, t.footprint_diameter, t.footprint_narrowest, t.footprint_widest, t.local.plastic_strain.value};
     std::printf("[ measured ] %s: L %.4f mm, D %.4f mm (%.4f-%.4f), peak plastic strain %.4f, %zu nodes\n", label.c_str(),
                 out.length * 1e3, out.footprint * 1e3, out.narrowest * 1e3, out.widest * 1e3, out.peak, sim.real_count());
@@ -93,6 +98,50 @@ TEST(ThreeD, TheCopperAndSteelBarsAndThePapersCylinderAgreeWithTwoDAtTheShippedS
                      run(damped_everywhere(scene_file("taylor-steel-208.toml", 8.0 / 15.0)), "steel 208, 2D"));
     expect_agreement(run(quarter_of(scene_file("armco-cylinder-nodal-3d.toml", 1.0)), "Armco cylinder, 3D quarter"),
                      run(damped_everywhere(scene_file("armco-cylinder-nodal.toml", 8.0 / 20.0)), "Armco cylinder, 2D"));
+}
+
+// The element solver at the spacing of a particle run: the 2D scene with every body meshed from
+// the same shapes (gpa study's variant discretisation=elements).
+Scene as_elements(Scene s) {
+    io::apply_variant(io::parse_variant("elements:discretisation=elements"), s);
+    return s;
+}
+
+// The issue's bounds against the elements at matched spacing (length 1 %, footprint 2 %, peak
+// plastic strain 10 %), at 12 nodes across the radius of the 7.62 mm bars: 3D quarters, the 2D
+// scene with the 3D damping and the element solver, all at the same spacing, the peaks averaged
+// over the same radius (two spacings). At the shipped 8 across the 3D footprints are 2-4 % below
+// the elements', and the 2D particles' with the same damping alike (docs/validation.md, "The
+// default"): coarse spacing in the particle method, not the third dimension; from 12 across they
+// are within the bound. The paper's cylinder is left out here: under the paper's preset its 2D
+// particle run is itself 1.9 % long against the elements at 12 across (3D 1.7 %), so the bound
+// does not hold for the method in either geometry at that spacing (docs/validation.md).
+TEST(ThreeD, TheCopperAndSteelBarsAgreeWithTheElementsAtMatchedSpacing) {
+    const double across = 12.0;
+    struct Case {
+        const char* label;
+        Scene solid, plane;
+    };
+    const Case cases[] = {
+        {"copper 190", scene_file("taylor-copper-190-3d-quarter.toml", across / 8.0), scene_file("taylor-copper-190.toml", across / 15.0)},
+        {"steel 208", quarter_of(scene_file("taylor-steel-208-3d.toml", across / 8.0)), scene_file("taylor-steel-208.toml", across / 15.0)},
+    };
+    for (const Case& c : cases) {
+        const std::string label = c.label;
+        const Shape solid = run(c.solid, label + ", 3D quarter");
+        const Shape elements = run(as_elements(c.plane), label + ", elements", element_energy_bound);
+        const Shape plane = run(damped_everywhere(c.plane), label + ", 2D");
+        std::printf("[ measured ] %s at %.0f across, 3D against elements: L %+.2f %%, D %+.2f %%, peak %+.1f %%; against 2D: "
+                    "L %+.2f %%, D %+.2f %%, peak %+.1f %%\n",
+                    c.label, across, 100 * (solid.length / elements.length - 1), 100 * (solid.footprint / elements.footprint - 1),
+                    100 * (solid.peak / elements.peak - 1), 100 * (solid.length / plane.length - 1),
+                    100 * (solid.footprint / plane.footprint - 1), 100 * (solid.peak / plane.peak - 1));
+        SCOPED_TRACE(label);
+        EXPECT_NEAR(solid.length / elements.length, 1.0, 0.01);
+        EXPECT_NEAR(solid.footprint / elements.footprint, 1.0, 0.02);
+        EXPECT_NEAR(solid.peak / elements.peak, 1.0, 0.10);
+        expect_agreement(solid, plane);
+    }
 }
 
 // The quarter model of the copper bar (scenes/taylor-copper-190-3d-quarter.toml) against the full bar,
