@@ -28,7 +28,9 @@ cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_FLAGS_RELEASE="-O1
   -DCMAKE_CXX_FLAGS="$flags" -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined" \
   -DGPA_BUILD_BENCHMARKS=OFF -DGPA_BUILD_SLOW_TESTS=OFF -DGPA_BUILD_TOOLS=OFF -DGPA_BUILD_FUZZERS=ON -DGPA_UNITY_BUILD=ON -DGPA_ENGINE_COMPILE_OPTIONS=-O2 \
   > "$build/configure.log" || { cat "$build/configure.log"; exit 1; }
+sanitize_build_start=$(date +%s)
 cmake --build "$build" -j"$jobs"
+echo "the sanitizer build took $(( $(date +%s) - sanitize_build_start )) s"
 
 # Reports inside third-party headers only, each explained in the file.
 export UBSAN_OPTIONS="suppressions=$PWD/tests/fuzz/ubsan.supp:print_stacktrace=1:halt_on_error=1"
