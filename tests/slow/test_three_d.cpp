@@ -107,6 +107,25 @@ Scene as_elements(Scene s) {
     return s;
 }
 
+// A 3D quarter (`solid`) and the 2D scene at the same spacing (`plane`), run as particles with the
+// 3D damping and as elements, against the bounds: against the elements length 1 %,
+// footprint 2 %, peak plastic strain 10 %; against 2D expect_agreement.
+void expect_agreement_with_elements(const std::string& label, double across, const Scene& solid_scene, const Scene& plane_scene) {
+    const Shape solid = run(solid_scene, label + ", 3D quarter");
+    const Shape elements = run(as_elements(plane_scene), label + ", elements", element_energy_bound);
+    const Shape plane = run(damped_everywhere(plane_scene), label + ", 2D");
+    std::printf("[ measured ] %s at %.0f across, 3D against elements: L %+.2f %%, D %+.2f %%, peak %+.1f %%; against 2D: "
+                "L %+.2f %%, D %+.2f %%, peak %+.1f %%\n",
+                label.c_str(), across, 100 * (solid.length / elements.length - 1), 100 * (solid.footprint / elements.footprint - 1),
+                100 * (solid.peak / elements.peak - 1), 100 * (solid.length / plane.length - 1),
+                100 * (solid.footprint / plane.footprint - 1), 100 * (solid.peak / plane.peak - 1));
+    SCOPED_TRACE(label);
+    EXPECT_NEAR(solid.length / elements.length, 1.0, 0.01);
+    EXPECT_NEAR(solid.footprint / elements.footprint, 1.0, 0.02);
+    EXPECT_NEAR(solid.peak / elements.peak, 1.0, 0.10);
+    expect_agreement(solid, plane);
+}
+
 // The bounds against the elements at matched spacing (length 1 %, footprint 2 %, peak
 // plastic strain 10 %), at 12 nodes across the radius of the 7.62 mm bars: 3D quarters, the 2D
 // scene with the 3D damping and the element solver, all at the same spacing, the peaks averaged
@@ -127,22 +146,7 @@ TEST(ThreeD, TheCopperAndSteelBarsAgreeWithTheElementsAtMatchedSpacing) {
         {"copper 190", scene_file("taylor-copper-190-3d-quarter.toml", across / 8.0), scene_file("taylor-copper-190.toml", across / 15.0)},
         {"steel 208", quarter_of(scene_file("taylor-steel-208-3d.toml", across / 8.0)), scene_file("taylor-steel-208.toml", across / 15.0)},
     };
-    for (const Case& c : cases) {
-        const std::string label = c.label;
-        const Shape solid = run(c.solid, label + ", 3D quarter");
-        const Shape elements = run(as_elements(c.plane), label + ", elements", element_energy_bound);
-        const Shape plane = run(damped_everywhere(c.plane), label + ", 2D");
-        std::printf("[ measured ] %s at %.0f across, 3D against elements: L %+.2f %%, D %+.2f %%, peak %+.1f %%; against 2D: "
-                    "L %+.2f %%, D %+.2f %%, peak %+.1f %%\n",
-                    c.label, across, 100 * (solid.length / elements.length - 1), 100 * (solid.footprint / elements.footprint - 1),
-                    100 * (solid.peak / elements.peak - 1), 100 * (solid.length / plane.length - 1),
-                    100 * (solid.footprint / plane.footprint - 1), 100 * (solid.peak / plane.peak - 1));
-        SCOPED_TRACE(label);
-        EXPECT_NEAR(solid.length / elements.length, 1.0, 0.01);
-        EXPECT_NEAR(solid.footprint / elements.footprint, 1.0, 0.02);
-        EXPECT_NEAR(solid.peak / elements.peak, 1.0, 0.10);
-        expect_agreement(solid, plane);
-    }
+    for (const Case& c : cases) expect_agreement_with_elements(c.label, across, c.solid, c.plane);
 }
 
 // The paper's cylinder (nodal viscosity) against the elements at matched spacing, with the issue's
@@ -162,19 +166,8 @@ TEST(ThreeD, ThePapersCylinderAgreesWithTheElementsAtMatchedSpacingUnderTheTaylo
         io::apply_variant(io::parse_variant("taylor:preset=taylor-bar"), s);
         return s;
     };
-    const Scene plane = taylor(scene_file("armco-cylinder-nodal.toml", across / 20.0));
-    const Shape solid = run(taylor(quarter_of(scene_file("armco-cylinder-nodal-3d.toml", across / 8.0))), "Armco cylinder, 3D quarter");
-    const Shape elements = run(as_elements(plane), "Armco cylinder, elements", element_energy_bound);
-    const Shape flat = run(damped_everywhere(plane), "Armco cylinder, 2D");
-    std::printf("[ measured ] Armco cylinder at %.0f across, 3D against elements: L %+.2f %%, D %+.2f %%, peak %+.1f %%; against 2D: "
-                "L %+.2f %%, D %+.2f %%, peak %+.1f %%\n",
-                across, 100 * (solid.length / elements.length - 1), 100 * (solid.footprint / elements.footprint - 1),
-                100 * (solid.peak / elements.peak - 1), 100 * (solid.length / flat.length - 1),
-                100 * (solid.footprint / flat.footprint - 1), 100 * (solid.peak / flat.peak - 1));
-    EXPECT_NEAR(solid.length / elements.length, 1.0, 0.01);
-    EXPECT_NEAR(solid.footprint / elements.footprint, 1.0, 0.02);
-    EXPECT_NEAR(solid.peak / elements.peak, 1.0, 0.10);
-    expect_agreement(solid, flat);
+    expect_agreement_with_elements("Armco cylinder", across, taylor(quarter_of(scene_file("armco-cylinder-nodal-3d.toml", across / 8.0))),
+                                   taylor(scene_file("armco-cylinder-nodal.toml", across / 20.0)));
 }
 
 // The quarter model of the copper bar (scenes/taylor-copper-190-3d-quarter.toml) against the full bar,
